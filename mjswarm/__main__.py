@@ -1,0 +1,7 @@
+"""``python -m mjswarm`` runs the CLI."""
+
+import sys
+
+from mjswarm.cli import main
+
+sys.exit(main())

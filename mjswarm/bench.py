@@ -1,0 +1,103 @@
+"""Benchmark: the full mjswarm step against bare ``mj_step`` on the same world.
+
+For each robot count N the benchmark builds one world (robots in a grid, each on its own
+floor strip, walls beside every row) and measures, in the same process and run:
+
+* ``realtime_factor``: simulated seconds per wall second of :meth:`Simulation.step`
+  with every sensor read at the control rate and a vectorised line-following controller
+  computing each robot's command from its own readings;
+* ``physics_only_realtime_factor``: the same for bare ``mj_step`` on the same compiled
+  model with sensors disabled and constant controls;
+* ``overhead_ratio``: their quotient (physics-only / full), i.e. how many times longer
+  a full step takes than bare physics.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass
+
+import mujoco
+import numpy as np
+
+from mjswarm.errors import MjswarmError
+from mjswarm.robot import DEFAULT_ROBOT_XML
+from mjswarm.simulation import Simulation
+from mjswarm.world import FloorStrip, Pose2D, WallSegment, world_spec
+
+ROW_SPACING_M = 0.5
+COLUMN_SPACING_M = 0.6
+BENCH_SPEED_M_S = 0.1
+
+
+@dataclass(frozen=True)
+class BenchResult:
+    """Figures for one robot count (rates in simulated seconds per wall second)."""
+
+    robots: int
+    sim_seconds: float
+    realtime_factor: float
+    physics_only_realtime_factor: float
+    overhead_ratio: float
+    robot_steps_per_s: float
+
+
+def bench_world(n: int, robot_xml: str = str(DEFAULT_ROBOT_XML)) -> Simulation:
+    """N robots in a near-square grid, each on a strip with a wall on its left."""
+    if n < 1:
+        raise MjswarmError(f"robot count must be >= 1, got {n}")
+    cols = math.ceil(math.sqrt(n))
+    rows = math.ceil(n / cols)
+    row_len = cols * COLUMN_SPACING_M + 2.0
+    poses = [Pose2D((i % cols) * COLUMN_SPACING_M, (i // cols) * ROW_SPACING_M) for i in range(n)]
+    strips = [FloorStrip((-0.5, r * ROW_SPACING_M), (row_len, r * ROW_SPACING_M)) for r in range(rows)]
+    walls = [
+        WallSegment((-0.5, r * ROW_SPACING_M + 0.13), (row_len, r * ROW_SPACING_M + 0.13))
+        for r in range(rows)
+    ]
+    return Simulation(world_spec(poses, strips, walls, robot_xml=robot_xml))
+
+
+def line_following_command(sim: Simulation) -> tuple[np.ndarray, np.ndarray]:
+    """A proportional line follower over all robots: turn towards the darker side."""
+    line = sim.readings()["line"]
+    height = sim.geometry.line_sensor_height_m
+    on = (height - line) > 0.001  # a strip under the sensor shortens the reading by 2 mm
+    steer = on[:, 0].astype(float) - on[:, 2].astype(float)
+    return np.full(sim.n, BENCH_SPEED_M_S), 0.8 * steer
+
+
+def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROBOT_XML)) -> BenchResult:
+    """Measure one robot count over ``sim_seconds`` of simulated time."""
+    if sim_seconds <= 0:
+        raise MjswarmError(f"benchmark duration must be positive, got {sim_seconds} s")
+    sim = bench_world(n, robot_xml)
+    ticks = max(1, round(sim_seconds / sim.control_dt_s))
+    start = time.perf_counter()
+    for _ in range(ticks):
+        sim.set_velocity(*line_following_command(sim))
+        sim.step()
+    full_wall = time.perf_counter() - start
+
+    bare = bench_world(n, robot_xml)
+    m, d = bare.model, bare.data
+    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+    bare.set_velocity(np.full(n, BENCH_SPEED_M_S), np.zeros(n))
+    start = time.perf_counter()
+    mujoco.mj_step(m, d, nstep=ticks * bare.substeps)
+    bare_wall = time.perf_counter() - start
+
+    simulated = ticks * sim.control_dt_s
+    return BenchResult(
+        robots=n,
+        sim_seconds=simulated,
+        realtime_factor=simulated / full_wall,
+        physics_only_realtime_factor=simulated / bare_wall,
+        overhead_ratio=full_wall / bare_wall,
+        robot_steps_per_s=n * ticks * sim.substeps / full_wall,
+    )
+
+
+def as_dict(result: BenchResult) -> dict:
+    return asdict(result)

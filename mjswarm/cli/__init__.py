@@ -1,0 +1,48 @@
+"""The ``mjswarm`` command line: a thin layer over the Python API.
+
+Each subcommand lives in its own module ``mjswarm.cli.<name>`` exposing
+``register(subparsers)``, which adds its parser and sets ``func`` (called with the
+parsed arguments, returns an exit status). User errors (:class:`MjswarmError`)
+become one line on stderr and exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from mjswarm import __version__
+from mjswarm.errors import MjswarmError
+
+#: Subcommand modules, in the order ``--help`` lists them.
+SUBCOMMANDS = ("bench",)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="mjswarm",
+        description="Embodied multi-robot exploration and connectivity on MuJoCo.",
+    )
+    parser.add_argument("--version", action="version", version=f"mjswarm {__version__}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name in SUBCOMMANDS:
+        importlib.import_module(f"mjswarm.cli.{name}").register(subparsers)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except MjswarmError as exc:
+        print(f"mjswarm: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("mjswarm: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,72 @@
+"""``mjswarm bench``: full step vs bare ``mj_step``, per robot count."""
+
+from __future__ import annotations
+
+import json
+import platform
+import sys
+
+from tqdm import tqdm
+
+from mjswarm.errors import MjswarmError
+
+
+def _counts(text: str) -> list[int]:
+    try:
+        counts = [int(part) for part in text.split(",") if part.strip()]
+    except ValueError:
+        raise MjswarmError(f"--robots takes comma-separated whole numbers, got '{text}'") from None
+    if not counts or min(counts) < 1:
+        raise MjswarmError(f"--robots needs counts >= 1, got '{text}'")
+    return counts
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "bench",
+        help="measure the full step against bare mj_step",
+        description=(
+            "Drive N robots (all sensors, line-following control) on a floor with strips and "
+            "report simulated seconds per wall second for the full mjswarm step and for bare "
+            "mj_step on the same world, and their ratio (overhead_ratio)."
+        ),
+    )
+    parser.add_argument("--robots", default="1,10,100,300", metavar="N,N,...",
+                        help="robot counts to measure (default: 1,10,100,300)")
+    parser.add_argument("--seconds", type=float, default=2.0, metavar="S",
+                        help="simulated seconds per measurement (default: 2.0)")
+    parser.add_argument("--model", default=None, metavar="MJCF",
+                        help="robot model file (default: models/spark_v.xml)")
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from mjswarm.bench import as_dict, run_bench
+    from mjswarm.robot import DEFAULT_ROBOT_XML, load_robot_spec
+
+    counts = _counts(args.robots)
+    model = args.model or str(DEFAULT_ROBOT_XML)
+    load_robot_spec(model)  # fail with one line before any progress bar
+    results = [
+        as_dict(run_bench(n, args.seconds, model))
+        for n in tqdm(counts, desc="bench", unit="world", disable=None, file=sys.stderr)
+    ]
+    if args.json:
+        print(json.dumps({"machine": _machine(), "results": results}, indent=2))
+        return 0
+    print(f"machine: {_machine()}")
+    print(f"{'robots':>7} {'realtime':>10} {'physics-only':>13} {'overhead':>9} {'robot-steps/s':>14}")
+    for r in results:
+        print(f"{r['robots']:>7} {r['realtime_factor']:>9.2f}x {r['physics_only_realtime_factor']:>12.2f}x"
+              f" {r['overhead_ratio']:>9.2f} {r['robot_steps_per_s']:>14.0f}")
+    return 0
+
+
+def _machine() -> str:
+    import os
+
+    import mujoco
+
+    return (f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+            f"Python {platform.python_version()}, MuJoCo {mujoco.__version__}")

@@ -1,0 +1,50 @@
+"""Robot-robot collision events, counted from ``data.contact``.
+
+Ground truth for metrics and tests only; controllers never see it. A collision *event*
+is a pair of robots that starts touching: a pair that stays in contact over several
+checks is one event, and it counts again only after it has separated.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+
+class CollisionCounter:
+    """Counts new touching robot pairs each time :meth:`update` is called.
+
+    Args:
+        geom_robot: for every geom of the model, the index of the robot it belongs
+            to, or -1 (floor, strips, walls).
+    """
+
+    def __init__(self, geom_robot: np.ndarray) -> None:
+        self._geom_robot = np.asarray(geom_robot, dtype=np.int64)
+        self._touching: set[tuple[int, int]] = set()
+        self.events: list[tuple[float, int, int]] = []
+
+    def touching_pairs(self, data: mujoco.MjData) -> set[tuple[int, int]]:
+        """Robot pairs ``(i, j)`` with ``i < j`` in contact in ``data`` right now."""
+        if data.ncon == 0:
+            return set()
+        geoms = data.contact.geom[: data.ncon]
+        robots = self._geom_robot[geoms]
+        mask = (robots[:, 0] >= 0) & (robots[:, 1] >= 0) & (robots[:, 0] != robots[:, 1])
+        if not mask.any():
+            return set()
+        pairs = np.sort(robots[mask], axis=1)
+        return {(int(a), int(b)) for a, b in pairs}
+
+    def update(self, data: mujoco.MjData) -> list[tuple[int, int]]:
+        """Record the pairs that started touching since the last call; return them."""
+        now = self.touching_pairs(data)
+        new = sorted(now - self._touching)
+        self._touching = now
+        self.events.extend((float(data.time), i, j) for i, j in new)
+        return new
+
+    @property
+    def count(self) -> int:
+        """Number of collision events so far."""
+        return len(self.events)

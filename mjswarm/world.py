@@ -1,0 +1,132 @@
+"""Building a MuJoCo world of N robots on a floor with line strips and walls.
+
+Everything is assembled with :class:`mujoco.MjSpec`: the robot template (see
+:mod:`mjswarm.robot`) is attached once per robot with the name prefix ``r<i>/``, so robot
+``i``'s sensors are ``r<i>/line_left`` ... and its actuators ``r<i>/wheel_left`` ...
+
+Floor marks (line strips) are thin boxes in geom group 3 with ``contype = conaffinity
+= 0``: the rangefinders see them (rays test every group) but the wheels never touch
+them. Walls are collision boxes in group 0. The arena builder
+(:mod:`mjswarm.arena.builder`) turns a graph spec into these primitives; tests and the
+benchmark use them directly.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from mjswarm.errors import MjswarmError
+from mjswarm.robot import DEFAULT_ROBOT_XML, ROOT_BODY, load_robot_spec
+
+#: Physics timestep (s) and integrator used for every world.
+PHYSICS_TIMESTEP_S = 0.002
+STRIP_GROUP = 3
+FLOOR_RGBA = (0.92, 0.92, 0.90, 1.0)
+STRIP_RGBA = (0.05, 0.05, 0.05, 1.0)
+WALL_RGBA = (0.55, 0.35, 0.25, 1.0)
+
+
+@dataclass(frozen=True)
+class Pose2D:
+    """A planar pose: position (m) and heading ``yaw`` (rad, CCW from +x)."""
+
+    x: float
+    y: float
+    yaw: float = 0.0
+
+
+@dataclass(frozen=True)
+class FloorStrip:
+    """A straight line strip on the floor, from ``start`` to ``end`` (m, m)."""
+
+    start: tuple[float, float]
+    end: tuple[float, float]
+    width_m: float = 0.02
+    thickness_m: float = 0.002
+
+
+@dataclass(frozen=True)
+class WallSegment:
+    """A straight wall whose centre line runs from ``start`` to ``end`` (m)."""
+
+    start: tuple[float, float]
+    end: tuple[float, float]
+    thickness_m: float = 0.02
+    height_m: float = 0.10
+
+
+def _segment_frame(start: Sequence[float], end: Sequence[float]) -> tuple[np.ndarray, float, float]:
+    """Midpoint, half-length (m) and yaw (rad) of a 2-D segment."""
+    a, b = np.asarray(start, float), np.asarray(end, float)
+    delta = b - a
+    length = float(np.hypot(*delta))
+    if not math.isfinite(length) or length <= 0.0:
+        raise MjswarmError(f"degenerate segment from {tuple(a)} to {tuple(b)}")
+    return (a + b) / 2.0, length / 2.0, math.atan2(delta[1], delta[0])
+
+
+def _yaw_quat(yaw: float) -> list[float]:
+    return [math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0)]
+
+
+def world_spec(
+    poses: Sequence[Pose2D],
+    strips: Iterable[FloorStrip] = (),
+    walls: Iterable[WallSegment] = (),
+    robot_xml: str = str(DEFAULT_ROBOT_XML),
+    timestep_s: float = PHYSICS_TIMESTEP_S,
+    margin_m: float = 1.0,
+) -> mujoco.MjSpec:
+    """An uncompiled world: floor, strips, walls and one robot per pose (``r0`` ...).
+
+    The floor is a plane covering every robot, strip and wall plus ``margin_m``.
+    Callers may add more elements (vertex sites, say) before compiling.
+    """
+    if timestep_s <= 0.0:
+        raise MjswarmError(f"physics timestep must be positive, got {timestep_s}")
+    strips, walls = list(strips), list(walls)
+    robot = load_robot_spec(robot_xml)
+    spec = mujoco.MjSpec()
+    spec.modelname = "mjswarm_world"
+    spec.copy_during_attach = True
+    spec.option.timestep = timestep_s
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.visual.global_.offwidth = 1280
+    spec.visual.global_.offheight = 960
+
+    points = [(p.x, p.y) for p in poses]
+    points += [pt for s in strips for pt in (s.start, s.end)]
+    points += [pt for w in walls for pt in (w.start, w.end)]
+    xy = np.array(points, float).reshape(-1, 2) if points else np.zeros((1, 2))
+    centre = (xy.min(axis=0) + xy.max(axis=0)) / 2.0
+    half = (xy.max(axis=0) - xy.min(axis=0)) / 2.0 + margin_m
+    spec.worldbody.add_light(pos=[centre[0], centre[1], 5.0], dir=[0, 0, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL)
+    spec.worldbody.add_geom(
+        name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, pos=[centre[0], centre[1], 0.0],
+        size=[half[0], half[1], 0.05], rgba=FLOOR_RGBA,
+    )
+    for i, strip in enumerate(strips):
+        mid, half_len, yaw = _segment_frame(strip.start, strip.end)
+        spec.worldbody.add_geom(
+            name=f"strip{i}", type=mujoco.mjtGeom.mjGEOM_BOX, group=STRIP_GROUP,
+            contype=0, conaffinity=0, rgba=STRIP_RGBA,
+            pos=[mid[0], mid[1], strip.thickness_m / 2.0], quat=_yaw_quat(yaw),
+            size=[half_len, strip.width_m / 2.0, strip.thickness_m / 2.0],
+        )
+    for i, wall in enumerate(walls):
+        mid, half_len, yaw = _segment_frame(wall.start, wall.end)
+        spec.worldbody.add_geom(
+            name=f"wall{i}", type=mujoco.mjtGeom.mjGEOM_BOX, rgba=WALL_RGBA,
+            pos=[mid[0], mid[1], wall.height_m / 2.0], quat=_yaw_quat(yaw),
+            size=[half_len, wall.thickness_m / 2.0, wall.height_m / 2.0],
+        )
+    template = robot.body(ROOT_BODY)
+    for i, pose in enumerate(poses):
+        frame = spec.worldbody.add_frame(pos=[pose.x, pose.y, 0.0], quat=_yaw_quat(pose.yaw))
+        frame.attach_body(template, f"r{i}/", "")
+    return spec

@@ -1,0 +1,186 @@
+"""Physics regression for the Spark V model: speeds, turns, sensors, contacts, stability."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from mjswarm.errors import MjswarmError
+from mjswarm.robot import load_robot_spec
+from mjswarm.simulation import Simulation, wrap_angle
+from mjswarm.world import FloorStrip, Pose2D, WallSegment, world_spec
+
+SETTLE_S = 1.0
+
+
+def drive(sim: Simulation, v: float, omega: float, seconds: float) -> None:
+    sim.set_velocity(np.full(sim.n, v), np.full(sim.n, omega))
+    sim.step(round(seconds / sim.control_dt_s))
+
+
+@pytest.mark.parametrize("speed", [0.05, 0.20])
+def test_straight_drive_speed_and_heading(one_robot, speed):
+    drive(one_robot, speed, 0.0, SETTLE_S)
+    start, t0 = one_robot.poses()[0].copy(), one_robot.time_s
+    while np.hypot(*(one_robot.poses()[0, :2] - start[:2])) < 1.0:
+        one_robot.step()
+    end = one_robot.poses()[0]
+    measured = np.hypot(*(end[:2] - start[:2])) / (one_robot.time_s - t0)
+    assert measured == pytest.approx(speed, rel=0.05)
+    assert abs(math.degrees(wrap_angle(end[2] - start[2]))) < 2.0
+    assert abs(end[1] - start[1]) < 0.035  # 2 degrees over 1 m
+
+
+def test_command_above_top_speed_is_capped(one_robot):
+    drive(one_robot, 0.5, 0.0, SETTLE_S)
+    x0, t0 = one_robot.poses()[0, 0], one_robot.time_s
+    drive(one_robot, 0.5, 0.0, 2.0)
+    measured = (one_robot.poses()[0, 0] - x0) / (one_robot.time_s - t0)
+    assert one_robot.geometry.max_speed_m_s == pytest.approx(0.20)
+    assert 0.19 <= measured <= 0.2001
+
+
+@pytest.mark.parametrize("omega", [-1.5, 0.8])
+def test_turn_in_place_matches_kinematics(one_robot, omega):
+    drive(one_robot, 0.0, omega, SETTLE_S)
+    t0 = one_robot.time_s
+    total = 0.0
+    for _ in range(100):
+        previous = one_robot.poses()[0, 2]
+        one_robot.step()
+        total += wrap_angle(one_robot.poses()[0, 2] - previous)
+    rate = total / (one_robot.time_s - t0)
+    assert rate == pytest.approx(omega, rel=0.05)
+    assert np.hypot(*one_robot.poses()[0, :2]) < 0.01  # turned on the spot
+
+
+def strip_world(offset_m: float) -> Simulation:
+    """A robot facing +x whose line sensors sit ``offset_m`` left of a strip along y = 0."""
+    strip = FloorStrip((-1.0, 0.0), (1.0, 0.0))
+    return Simulation(world_spec([Pose2D(0.0, offset_m, 0.0)], strips=[strip]))
+
+
+def test_line_sensor_sees_a_strip_with_margin():
+    on = strip_world(0.0)
+    off = strip_world(0.3)
+    on.step(10)
+    off.step(10)
+    height = on.geometry.line_sensor_height_m
+    floor = off.readings()["line"][0]
+    centred = on.readings()["line"][0]
+    # bare floor reads the mounting height everywhere
+    np.testing.assert_allclose(floor, height, atol=0.001)
+    # the 2 mm strip: centre sensor shorter by 2 mm, its neighbours see floor
+    assert floor[1] - centred[1] == pytest.approx(0.002, abs=2e-4)
+    assert abs(centred[0] - floor[0]) < 1e-4 and abs(centred[2] - floor[2]) < 1e-4
+
+
+@pytest.mark.parametrize("offset,sensor", [(0.022, 2), (-0.022, 0)])
+def test_side_line_sensors_respond_to_offset(offset, sensor):
+    sim = strip_world(offset)  # robot left of the strip: the right sensor is over it
+    sim.step(10)
+    line = sim.readings()["line"][0]
+    assert line[1] - line[sensor] == pytest.approx(0.002, abs=2e-4)
+
+
+@pytest.mark.parametrize("gap_m", [0.02, 0.035, 0.05, 0.07, 0.09])
+def test_ir_reads_wall_distance(gap_m):
+    sim = Simulation(world_spec([Pose2D(0.0, 0.0, 0.0)], walls=[]))
+    rim = sim.model.site("r0/ir_left").pos[1]  # the sensor's lateral offset from the centre
+    wall_y = rim + gap_m + 0.01  # wall centre line; its face is 1 cm nearer
+    sim = Simulation(world_spec([Pose2D(0.0, 0.0, 0.0)],
+                                walls=[WallSegment((-0.5, wall_y), (0.5, wall_y))]))
+    sim.step(10)
+    ir = sim.readings()["ir"][0]
+    assert ir[0] == pytest.approx(gap_m, abs=0.005)
+    assert np.isnan(ir[1]) and np.isnan(ir[2])
+
+
+@pytest.mark.parametrize("gap_m", [0.105, 0.3])
+def test_ir_reads_nothing_beyond_range(gap_m):
+    wall_x = 0.071 + gap_m + 0.01
+    sim = Simulation(world_spec([Pose2D(0.0, 0.0, 0.0)],
+                                walls=[WallSegment((wall_x, -0.5), (wall_x, 0.5))]))
+    sim.step(10)
+    assert np.isnan(sim.readings()["ir"][0]).all()
+
+
+def test_ten_minutes_of_random_commands_stay_stable():
+    """Like menagerie's model tests: no NaN, no warning, upright, on the floor."""
+    walls = [WallSegment(a, b) for a, b in [((-1, -1), (1, -1)), ((1, -1), (1, 1)),
+                                               ((1, 1), (-1, 1)), ((-1, 1), (-1, -1))]]
+    poses = [Pose2D(-0.4, -0.4, 0.3), Pose2D(0.4, 0.0, 2.0), Pose2D(-0.3, 0.5, -1.0)]
+    sim = Simulation(world_spec(poses, walls=walls))
+    rng = np.random.default_rng(7)
+    min_up, heights = 1.0, []
+    for _ in range(600):  # one new command per simulated second
+        sim.set_wheel_speeds(rng.uniform(-12.0, 12.0, size=(sim.n, 2)))
+        sim.step(round(1.0 / sim.control_dt_s))
+        min_up = min(min_up, sim.uprightness().min())
+        heights.append(sim.heights())
+    assert sim.time_s == pytest.approx(600.0)
+    assert np.isfinite(sim.data.qpos).all() and np.isfinite(sim.data.qvel).all()
+    assert sim.warnings() == {}
+    assert min_up > math.cos(math.radians(10))
+    assert np.all(np.abs(np.array(heights) - 0.025) < 0.005)
+    assert np.all(np.abs(sim.poses()[:, :2]) < 1.0)
+
+
+def test_head_on_robots_register_one_collision_event():
+    sim = Simulation(world_spec([Pose2D(-0.3, 0.0, 0.0), Pose2D(0.3, 0.0, math.pi)]))
+    drive(sim, 0.1, 0.0, 4.0)
+    assert sim.collisions.count == 1
+    _, i, j = sim.collisions.events[0]
+    assert (i, j) == (0, 1)
+
+
+def test_robots_side_by_side_never_collide():
+    sim = Simulation(world_spec([Pose2D(0.0, 0.0, 0.0), Pose2D(0.0, 0.2, 0.0)]))
+    drive(sim, 0.2, 0.0, 3.0)
+    assert sim.collisions.count == 0
+
+
+def qpos_history(seed: int) -> np.ndarray:
+    sim = Simulation(world_spec([Pose2D(0.0, 0.0, 0.0), Pose2D(0.5, 0.3, 1.0)]),
+                     seed=seed, line_noise_m=0.0005, ir_noise_m=0.001)
+    rng = np.random.default_rng(seed)
+    history = []
+    for _ in range(100):
+        sim.set_wheel_speeds(rng.uniform(-8, 8, (sim.n, 2)))
+        sim.step()
+        history.append(np.concatenate([sim.data.qpos, sim.readings()["line"].ravel()]))
+    return np.array(history)
+
+
+def test_same_seed_same_trajectory_bit_for_bit():
+    a, b = qpos_history(3), qpos_history(3)
+    assert np.array_equal(a, b)
+    assert not np.array_equal(a, qpos_history(4))
+
+
+def test_missing_model_file_is_one_clear_error(tmp_path):
+    with pytest.raises(MjswarmError, match="robot model not found"):
+        load_robot_spec(tmp_path / "nope.xml")
+
+
+def test_malformed_model_file_is_one_clear_error(tmp_path):
+    bad = tmp_path / "bad.xml"
+    bad.write_text("<mujoco><worldbody><body")
+    with pytest.raises(MjswarmError, match="malformed robot model") as info:
+        load_robot_spec(bad)
+    assert "\n" not in str(info.value)
+
+
+def test_model_without_sensors_is_rejected(tmp_path):
+    bare = tmp_path / "bare.xml"
+    bare.write_text('<mujoco><worldbody><body name="spark_v"><freejoint/>'
+                    '<geom size="0.05"/></body></worldbody></mujoco>')
+    with pytest.raises(MjswarmError, match="lacks required elements: line_left"):
+        load_robot_spec(bare)
+
+
+def test_control_rate_must_divide_physics_rate():
+    with pytest.raises(MjswarmError, match="must divide"):
+        Simulation(world_spec([Pose2D(0, 0)]), control_hz=33.0)
