@@ -16,7 +16,7 @@ from mjswarm import __version__
 from mjswarm.errors import MjswarmError
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ("bench",)
+SUBCOMMANDS = ("bench", "arena")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -42,6 +42,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("mjswarm: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # e.g. `mjswarm ... | head`: the reader left, nothing to say
+        sys.stderr.close()
+        return 0
 
 
 if __name__ == "__main__":

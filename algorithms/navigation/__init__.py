@@ -1,0 +1,19 @@
+"""Sensor-only navigation on line-marked arenas (seed 003, Sec. 5).
+
+Pure Python: the embodied adapter (:mod:`mjswarm.embodied`) feeds each robot's own
+readings (line sensors, IR, wheel encoders) in, and applies the ``(v, omega)`` that comes
+out. Nothing here knows the arena graph or any ground truth.
+"""
+
+from algorithms.navigation.navigator import ArenaConventions, Navigator, NavigatorState
+from algorithms.navigation.odometry import Odometry, RobotCalibration
+from algorithms.navigation.percept import Percept
+
+__all__ = [
+    "ArenaConventions",
+    "Navigator",
+    "NavigatorState",
+    "Odometry",
+    "Percept",
+    "RobotCalibration",
+]

@@ -1,0 +1,249 @@
+"""A robot's way around a line-marked arena, from its own sensors only (seed 003, Sec. 5).
+
+The arena conventions (the marks a robot is built to read, not the graph): every edge has
+two lane strips ``lane_offset_m`` either side of its centre line, and a robot drives on
+the one to its left; walls line each edge, so the left IR sensor sees a wall on an edge
+and none at a vertex ("the proximity sensor detects a vertex by detecting the absence of
+an obstacle", Sec. 5); at each vertex a short centre-line *spoke* per incident edge runs
+from ``spoke_inner_radius_m`` to ``spoke_radius_m``.
+
+Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
+
+* **on an edge**: follow the lane; once the left wall has been seen for
+  ``min_wall_run_m`` and then lost, the vertex is detected; the lane then ends;
+* **arriving**: shift right by ``lane_offset_m`` onto the centre line (turn 60 degrees,
+  drive, turn back), find and follow the incoming spoke to its inner end, drive
+  ``line_ahead_m + spoke_inner_radius_m`` to stand on the vertex centre;
+* **discovering edges**: rotate once in place (:class:`~.motions.Scan`); every spoke
+  crossed gives an incidence angle, measured with encoder odometry. The robot corrects
+  its heading with the edge it came by: a straight edge leaves ``u`` at angle ``a`` and
+  enters ``v`` at ``a + pi``, so the spoke nearest to that is the incoming one and the
+  difference is odometry drift since leaving ``u``;
+* **leaving**: turn to the chosen spoke, follow it to its outer end, shift left by
+  ``lane_offset_m`` and find the lane ahead.
+
+Choices: the approach and departure shifts are open-loop odometry manoeuvres at 60
+degrees; the vertex-centre estimate has the accuracy of line following plus a 8 cm
+odometry drive (a few millimetres), which keeps scan angles within a few degrees.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+from enum import Enum
+
+from algorithms.navigation.motions import Drive, FollowLine, Scan, SeekLine, Turn, wrap
+from algorithms.navigation.odometry import Odometry, RobotCalibration
+from algorithms.navigation.percept import Percept
+
+SHIFT_ANGLE = math.radians(60.0)
+
+
+@dataclass(frozen=True)
+class ArenaConventions:
+    """The arena marks a robot is built to read (metres, radians); see module docstring."""
+
+    lane_offset_m: float
+    spoke_inner_radius_m: float
+    spoke_radius_m: float
+    min_wall_run_m: float = 0.05
+    max_seek_m: float = 0.40
+
+
+class NavigatorState(Enum):
+    SCANNING = "scanning"
+    AT_VERTEX = "at_vertex"  # edges known, waiting for depart()
+    LEAVING = "leaving"
+    ON_EDGE = "on_edge"
+    ARRIVING = "arriving"
+    LOST = "lost"  # lost its line: needs help (the paper's robots were placed back by hand)
+
+
+class Navigator:
+    """One robot's navigation state machine.
+
+    Args:
+        calibration: the robot's own body constants.
+        conventions: the arena marks it reads.
+        heading: the robot's initial heading in its reference frame (rad), e.g. from a
+            compass at the root; all incidence angles are reported in this frame.
+        speed_m_s: cruising speed.
+        turn_rate_rad_s: in-place turn and scan rate.
+    """
+
+    def __init__(self, calibration: RobotCalibration, conventions: ArenaConventions,
+                 heading: float = 0.0, speed_m_s: float = 0.05,
+                 turn_rate_rad_s: float = 1.0) -> None:
+        self.cal, self.conv = calibration, conventions
+        self.odometry = Odometry(calibration, theta=heading)
+        self.speed = speed_m_s
+        self.turn_rate = turn_rate_rad_s
+        self.state = NavigatorState.AT_VERTEX
+        self.edge_angles: list[float] = []
+        self.arrived_angle: float | None = None
+        self.events: list[str] = []
+        self._plan: deque = deque()
+        self._departed: float | None = None
+        self._incoming: float | None = None
+        self._tracks: list[float] = []  # effective track estimates, one per scan (m)
+        self._lane: FollowLine | None = None
+        self._wall_run_start: float | None = None
+        self._wall_seen = False
+        self.vertex_detected = False
+
+    # ---------------------------------------------------------------- control
+    def begin_at_vertex(self) -> None:
+        """Start on a vertex centre (the root): discover its edges."""
+        self._start_scan()
+
+    def depart(self, angle: float) -> None:
+        """Leave the vertex along the spoke at incidence ``angle`` (rad, own frame)."""
+        if self.state is not NavigatorState.AT_VERTEX:
+            raise RuntimeError(f"depart() needs the robot at a vertex, it is {self.state.value}")
+        self._departed = angle % (2.0 * math.pi)
+        self._plan = deque([
+            (Turn(angle, self.turn_rate), None),
+            (FollowLine(self.speed), None),
+            *self._shift(angle, +1),
+            (SeekLine(angle, self.speed, self.conv.max_seek_m), self._found_lane),
+        ])
+        self.state = NavigatorState.LEAVING
+        self.events.append("left_vertex")
+
+    def update(self, percept: Percept) -> tuple[float, float]:
+        """Advance one control tick; return the ``(v, omega)`` command (m/s, rad/s)."""
+        self.odometry.update(percept.encoders)
+        if self.state is NavigatorState.ON_EDGE:
+            self._watch_wall(percept)
+        while self._plan:
+            motion, on_done = self._plan[0]
+            command = motion.step(self.odometry, percept)
+            if command is not None:
+                return command
+            self._plan.popleft()
+            if on_done is not None:
+                on_done(motion)
+        return 0.0, 0.0
+
+    # ---------------------------------------------------------------- plans
+    def _shift(self, heading: float, side: int) -> list:
+        """Sidestep ``lane_offset_m`` to the left (side=+1) or right (-1) of ``heading``."""
+        diagonal = heading + side * SHIFT_ANGLE
+        return [
+            (Turn(diagonal, self.turn_rate), None),
+            (Drive(self.conv.lane_offset_m / math.sin(SHIFT_ANGLE), diagonal, self.speed), None),
+            (Turn(heading, self.turn_rate), None),
+        ]
+
+    def _found_lane(self, seek: SeekLine) -> None:
+        if seek.failed:
+            self._lose("no lane strip ahead after leaving the vertex")
+            return
+        self.state = NavigatorState.ON_EDGE
+        self.vertex_detected = False
+        self._wall_seen = False
+        self._wall_run_start = None
+        self._lane = FollowLine(self.speed)
+        self._plan = deque([(self._lane, self._lane_ended)])
+
+    def _watch_wall(self, percept: Percept) -> None:
+        """Vertex detection: the left wall, once seen on this edge, disappears."""
+        travelled = self.odometry.distance_m
+        if percept.wall_left:
+            if self._wall_run_start is None:
+                self._wall_run_start = travelled
+            if travelled - self._wall_run_start >= self.conv.min_wall_run_m:
+                self._wall_seen = True
+        else:
+            self._wall_run_start = None
+            if self._wall_seen and not self.vertex_detected:
+                self.vertex_detected = True
+                self.events.append("vertex_detected")
+
+    def _lane_ended(self, lane: FollowLine) -> None:
+        if not self.vertex_detected:
+            self._lose("lane ended with the wall still beside the robot")
+            return
+        self.state = NavigatorState.ARRIVING
+        heading = lane.direction(self.odometry.theta, last=None)
+        # the lane's direction in the odometry frame, carried to the scan: the incoming
+        # spoke lies opposite it (a better reference than the angle measured at the last
+        # vertex, which carries that scan's error)
+        self._incoming = (heading + math.pi) % (2.0 * math.pi)
+        self._plan = deque([
+            *self._shift(heading, -1),
+            (SeekLine(heading, self.speed, self.conv.max_seek_m), self._found_spoke),
+            (FollowLine(self.speed), self._spoke_ended),
+        ])
+
+    def _found_spoke(self, seek: SeekLine) -> None:
+        if seek.failed:
+            self._lose("no spoke found at the vertex")
+
+    def _spoke_ended(self, spoke: FollowLine) -> None:
+        """The sensor passed the spoke's inner end: the centre is ``line_ahead +
+        spoke_inner_radius`` beyond where the axle was then."""
+        heading = spoke.direction(self.odometry.theta)
+        beyond = self.odometry.distance_m - spoke.ended_at_m
+        centre = self.cal.line_ahead_m + self.conv.spoke_inner_radius_m - beyond
+        self._plan.append((Drive(centre, heading, self.speed), lambda _: self._start_scan()))
+
+    def _start_scan(self) -> None:
+        self.state = NavigatorState.SCANNING
+        self._plan = deque([(Scan(self.turn_rate), self._scanned)])
+
+    def _scanned(self, scan: Scan) -> None:
+        """Calibrate, then turn the scan's crossings into incidence angles."""
+        used = self.odometry.track_m
+        if scan.full_turn is not None:
+            # odometry over-reads rotation by full_turn / 2 pi: the effective track is
+            # that much wider; average over all scans so one noisy turn counts little
+            self._tracks.append(used * scan.full_turn / (2.0 * math.pi))
+            self.odometry.track_m = sum(self._tracks) / len(self._tracks)
+        scale = used / self.odometry.track_m  # true rotation per odometry rotation
+        self.odometry.theta = scan.start + scan.swept * scale
+        angles = sorted((scan.start + m * scale) % (2.0 * math.pi) for m in scan.mids)
+        self.edge_angles = angles
+        self.arrived_angle = None
+        if self._incoming is not None and angles:
+            self.arrived_angle = self._incoming
+            self.edge_angles = off_centre_correction(
+                angles, self.arrived_angle, self.cal.line_ahead_m)
+        self.state = NavigatorState.AT_VERTEX
+        self.events.append("arrived")
+
+    def _lose(self, why: str) -> None:
+        self.state = NavigatorState.LOST
+        self._plan.clear()
+        self.events.append(f"lost: {why}")
+
+
+def off_centre_correction(angles: list[float], incoming: float, radius: float) -> list[float]:
+    """Spoke directions corrected for the robot scanning off the vertex centre.
+
+    The centre line sensor sweeps a circle of ``radius`` around the axle. With the axle
+    at offset ``p`` from the vertex centre, it crosses the spoke of direction ``alpha``
+    at the heading ``phi`` where ``cross(p + radius u(phi), u(alpha)) = 0``, i.e.
+    ``radius sin(alpha - phi) = -cross(p, u(alpha))``. The incoming spoke's direction is
+    known (the robot came along it), so its crossing gives the offset across it,
+    ``p = -radius sin(phi_in - alpha_in) n_in`` (``n_in`` its left normal; the offset
+    along it is taken as zero: the approach stops there to a few millimetres). Every
+    other spoke is then solved by fixed-point iteration. The incoming spoke is reported
+    at exactly ``incoming``. Angles in radians, [0, 2 pi).
+    """
+    phi_in = min(angles, key=lambda a: abs(wrap(a - incoming)))
+    s = -radius * math.sin(phi_in - incoming)
+    px, py = -s * math.sin(incoming), s * math.cos(incoming)
+    corrected = []
+    for phi in angles:
+        if phi == phi_in:
+            corrected.append(incoming % (2.0 * math.pi))
+            continue
+        alpha = phi
+        for _ in range(4):
+            across = px * math.sin(alpha) - py * math.cos(alpha)  # cross(p, u(alpha))
+            alpha = phi - math.asin(max(-1.0, min(1.0, across / radius)))
+        corrected.append(alpha % (2.0 * math.pi))
+    return sorted(corrected)

@@ -1,0 +1,63 @@
+"""Wheel-encoder odometry for a differential-drive robot."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class RobotCalibration:
+    """What a robot knows about its own body (metres, radians).
+
+    Attributes:
+        wheel_radius_m: driven wheel radius.
+        track_m: distance between the driven wheels.
+        line_ahead_m: how far ahead of the axle the line sensors look.
+        max_speed_m_s: top forward speed.
+    """
+
+    wheel_radius_m: float
+    track_m: float
+    line_ahead_m: float
+    max_speed_m_s: float
+
+
+class Odometry:
+    """Dead reckoning from wheel angles: the exact arc model per update.
+
+    Between two updates the wheels turned by ``dl``, ``dr`` (rad); the robot moved
+    ``ds = r (dl + dr) / 2`` along an arc while turning ``dtheta = r (dr - dl) / b``;
+    the midpoint heading is used for the translation. The pose is in the robot's own
+    frame of reference: its start pose is whatever it is told (e.g. a compass heading
+    at the root), never read from the world.
+    """
+
+    def __init__(self, calibration: RobotCalibration, x: float = 0.0, y: float = 0.0,
+                 theta: float = 0.0) -> None:
+        self.cal = calibration
+        self.track_m = calibration.track_m  # effective track, refined by calibration
+        self.x, self.y, self.theta = x, y, theta
+        self.distance_m = 0.0  # total path length driven (forward counts positive)
+        self._last: tuple[float, float] | None = None
+
+    def update(self, encoders: tuple[float, float]) -> None:
+        """Integrate the wheel motion since the previous call."""
+        if self._last is None:
+            self._last = encoders
+            return
+        dl = encoders[0] - self._last[0]
+        dr = encoders[1] - self._last[1]
+        self._last = encoders
+        r, b = self.cal.wheel_radius_m, self.track_m
+        ds = r * (dl + dr) / 2.0
+        dtheta = r * (dr - dl) / b
+        mid = self.theta + dtheta / 2.0
+        self.x += ds * math.cos(mid)
+        self.y += ds * math.sin(mid)
+        self.theta += dtheta
+        self.distance_m += ds
+
+    def correct_heading(self, delta_rad: float) -> None:
+        """Rotate the heading estimate by ``delta_rad`` (a landmark-based correction)."""
+        self.theta += delta_rad
