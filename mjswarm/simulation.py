@@ -104,11 +104,11 @@ class Simulation:
         self._enc_adr = m.sensor_adr[ids(sens, ENCODERS)]
         self._vel_adr = m.sensor_adr[ids(sens, WHEEL_SPEED_SENSORS)]
         self._ir_cutoff = m.sensor_cutoff[ids(sens, IR_SENSORS)]
-        self._bodies = ids(mujoco.mjtObj.mjOBJ_BODY, (ROOT_BODY,))[:, 0]
-        joints = m.body_jntadr[self._bodies]
+        self.robot_bodies = ids(mujoco.mjtObj.mjOBJ_BODY, (ROOT_BODY,))[:, 0]
+        joints = m.body_jntadr[self.robot_bodies]
         self._qpos_adr = m.jnt_qposadr[joints]
         geom_robot = np.full(m.ngeom, -1, dtype=np.int64)
-        for i, root in enumerate(self._bodies):
+        for i, root in enumerate(self.robot_bodies):
             geom_robot[np.isin(m.geom_bodyid, self._subtree(root))] = i
         self.geom_robot = geom_robot
         if self.n == 0:
@@ -215,7 +215,7 @@ class Simulation:
 
     def uprightness(self) -> np.ndarray:
         """Cosine of each chassis's tilt from vertical, shape (N,) (1 = upright)."""
-        return self.data.xmat[self._bodies][:, 8].copy()
+        return self.data.xmat[self.robot_bodies][:, 8].copy()
 
     def warnings(self) -> dict[str, int]:
         """MuJoCo warnings raised so far, by name (empty when none)."""

@@ -1,0 +1,144 @@
+"""The bearing-rate speed-change collision rule of seed 003, Sec. 4.
+
+Each robot ``R_k`` sees the bearings ``beta_kp`` of the robots ``R_p`` in its field of
+view and changes only its own linear speed ``S_k``:
+
+* Lemma 2 / eq. (17): a collision with ``R_p`` is possible only if ``d beta_kp / dt = 0``;
+  we estimate the rate by a least-squares slope over the last ``window`` bearings and call
+  it zero when ``|rate| < zero_rate``;
+* eq. (27), on detection: ``S_k = 0`` if ``beta_kp = 0`` (``R_p`` ahead on the same
+  lane; we take ``|beta| < same_lane``), else ``S_k = S_k - eps_k S``;
+* eq. (33), when ``R_p`` leaves the field of view and a reduction for it applies:
+  ``S_k = S`` if ``S_k = 0``, else ``S_k = S_k + eps_k S``;
+* eq. (34), when ``R_k`` crosses the common vertex: ``S_k = S``, and the pending
+  reductions no longer apply (they are forgotten: no later increase by (33));
+* eq. (28): distinct ``eps_1 < (K-1) eps_1 < eps_2 < ... < (K-1) eps_K < 1``
+  (:func:`epsilons`), so a lower-numbered robot always slows less (Theorem 3).
+
+Choices where the paper is silent (see also :class:`CollisionRule`):
+
+* a reduction is applied once per robot ``R_p`` until (33) or (34) clears it
+  (Corollary 2: one reduction per robot in collision);
+* with ``K = 2`` eq. (28) reads ``eps_1 < eps_1``; we read its inequalities between one
+  robot's own terms as ``<=`` (the paper's own 0.05 / 0.25 for two robots need that);
+* the speed never goes below 0 (a robot with several pending reductions stops);
+* a robot stopped by (27) for several robots ahead on its lane resumes by (33) only when
+  the last of them has left its view.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field
+
+
+def epsilons(k: int, largest: float = 0.5, spread: float = 1.5) -> list[float]:
+    """Speed-change terms ``eps_1 .. eps_K`` satisfying eq. (28).
+
+    ``eps_K = min(largest, 0.95 / (K - 1))`` and ``eps_k = eps_{k+1} / ((K - 1) spread)``,
+    so ``(K - 1) eps_k < eps_{k+1}`` with room ``spread > 1`` and ``(K - 1) eps_K < 1``.
+    """
+    if k < 1:
+        raise ValueError(f"team size must be >= 1, got {k}")
+    if spread <= 1.0 or not 0.0 < largest < 1.0:
+        raise ValueError("need spread > 1 and 0 < largest < 1")
+    if k == 1:
+        return [largest]
+    top = min(largest, 0.95 / (k - 1))
+    eps = [top]
+    for _ in range(k - 1):
+        eps.append(eps[-1] / ((k - 1) * spread))
+    return eps[::-1]
+
+
+def satisfies_28(eps: list[float]) -> bool:
+    """Check eq. (28) for a team of ``len(eps)`` robots (``<=`` within a robot's terms)."""
+    k = len(eps)
+    if k == 1:  # a lone robot meets nobody
+        return 0.0 < eps[0] < 1.0
+    chain = []
+    for e in eps:
+        chain += [e, (k - 1) * e]
+    for (a, b), i in zip(zip(chain, chain[1:]), range(len(chain) - 1)):
+        same_robot = i % 2 == 0
+        if not (a <= b if same_robot else a < b):
+            return False
+    return chain[-1] < 1.0
+
+
+@dataclass
+class CollisionRule:
+    """One robot's speed under eqs. (27), (33), (34).
+
+    Args:
+        initial_speed: ``S`` (m/s).
+        epsilon: this robot's ``eps_k`` (from :func:`epsilons`).
+        zero_rate: ``|d beta / dt|`` below this (rad/s) counts as zero (eq. 17).
+        same_lane: ``|beta|`` below this (rad) counts as ``beta = 0`` in (27).
+        window: number of bearing samples in the rate estimate (at the control rate).
+        dt: time between samples (s).
+    """
+
+    initial_speed: float
+    epsilon: float
+    zero_rate: float = 0.02
+    same_lane: float = math.radians(8.0)
+    window: int = 10
+    dt: float = 0.02
+    speed: float = field(init=False)
+    activations: int = field(default=0, init=False)
+    _history: dict[int, deque] = field(default_factory=dict, init=False)
+    _pending: dict[int, str] = field(default_factory=dict, init=False)  # p -> "stop"/"slow"
+
+    def __post_init__(self) -> None:
+        self.speed = self.initial_speed
+
+    def bearing_rate(self, p: int) -> float | None:
+        """Least-squares slope (rad/s) of ``beta_kp`` over the window, None if too short."""
+        samples = self._history.get(p)
+        if samples is None or len(samples) < self.window:
+            return None
+        n = len(samples)
+        t_mean = (n - 1) / 2.0
+        b_mean = sum(samples) / n
+        num = sum((i - t_mean) * (b - b_mean) for i, b in enumerate(samples))
+        den = sum((i - t_mean) ** 2 for i in range(n))
+        return num / den / self.dt
+
+    def update(self, bearings: dict[int, float]) -> float:
+        """Take this tick's bearings ``{p: beta_kp}`` (rad) and return ``S_k`` (m/s)."""
+        for p in list(self._history):
+            if p not in bearings:
+                del self._history[p]
+                self._out_of_view(p)
+        for p, beta in bearings.items():
+            samples = self._history.setdefault(p, deque(maxlen=self.window))
+            if samples:  # unwrap against the previous sample
+                beta = samples[-1] + math.remainder(beta - samples[-1], 2.0 * math.pi)
+            samples.append(beta)
+            rate = self.bearing_rate(p)
+            if p in self._pending or rate is None or abs(rate) >= self.zero_rate:
+                continue
+            self.activations += 1
+            if abs(math.remainder(beta, 2.0 * math.pi)) < self.same_lane:  # eq. (27), beta = 0
+                self._pending[p] = "stop"
+                self.speed = 0.0
+            else:  # eq. (27), otherwise
+                self._pending[p] = "slow"
+                self.speed = max(0.0, self.speed - self.epsilon * self.initial_speed)
+        return self.speed
+
+    def _out_of_view(self, p: int) -> None:
+        """Eq. (33): the reduction for ``p`` no longer needed once it is out of view."""
+        if self._pending.pop(p, None) is None:
+            return
+        if self.speed == 0.0 and not any(v == "stop" for v in self._pending.values()):
+            self.speed = self.initial_speed
+        elif self.speed > 0.0:
+            self.speed = min(self.initial_speed, self.speed + self.epsilon * self.initial_speed)
+
+    def crossed_vertex(self) -> None:
+        """Eq. (34): back to ``S``; pending reductions no longer apply."""
+        self.speed = self.initial_speed
+        self._pending.clear()
