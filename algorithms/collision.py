@@ -23,7 +23,10 @@ Choices where the paper is silent (see also :class:`CollisionRule`):
   robot's own terms as ``<=`` (the paper's own 0.05 / 0.25 for two robots need that);
 * the speed never goes below 0 (a robot with several pending reductions stops);
 * a robot stopped by (27) for several robots ahead on its lane resumes by (33) only when
-  the last of them has left its view.
+  the last of them has left its view;
+* a stop (27, ``beta = 0``) also ends, as by (33), when the robot ahead is no longer
+  ahead (``|beta| >= 2 same_lane``): on collinear edges a robot that went on and came back
+  on the other lane stays in view, and waiting for it to leave the view deadlocks.
 """
 
 from __future__ import annotations
@@ -117,6 +120,9 @@ class CollisionRule:
             if samples:  # unwrap against the previous sample
                 beta = samples[-1] + math.remainder(beta - samples[-1], 2.0 * math.pi)
             samples.append(beta)
+            if self._pending.get(p) == "stop" and abs(math.remainder(beta, 2 * math.pi)) >= (
+                    2.0 * self.same_lane):
+                self._out_of_view(p)  # no longer ahead on this lane: resume as by (33)
             rate = self.bearing_rate(p)
             if p in self._pending or rate is None or abs(rate) >= self.zero_rate:
                 continue
@@ -137,6 +143,10 @@ class CollisionRule:
             self.speed = self.initial_speed
         elif self.speed > 0.0:
             self.speed = min(self.initial_speed, self.speed + self.epsilon * self.initial_speed)
+
+    def forget_bearings(self) -> None:
+        """Drop the bearing histories (the rule is paused; see mjswarm.embodied)."""
+        self._history.clear()
 
     def crossed_vertex(self) -> None:
         """Eq. (34): back to ``S``; pending reductions no longer apply."""

@@ -36,6 +36,7 @@ from mjswarm.robot import (
     WHEEL_SPEED_SENSORS,
     measure_geometry,
 )
+from mjswarm.world import Pose2D
 
 #: One robot's sensor record: line rangefinders (m), IR distances (m, NaN = nothing
 #: within range), wheel encoders (rad), wheel speeds (rad/s), battery voltage (V).
@@ -156,6 +157,18 @@ class Simulation:
         peak = np.abs(wheels).max(axis=1, keepdims=True)
         scale = np.where(peak > g.max_wheel_speed_rad_s, g.max_wheel_speed_rad_s / np.maximum(peak, 1e-12), 1.0)
         self.set_wheel_speeds(wheels * scale)
+
+    def place_robot(self, i: int, pose: Pose2D) -> None:
+        """Put robot ``i`` down at ``pose``, at rest (the experimenter's hand, not physics)."""
+        adr = self._qpos_adr[i]
+        dof = self.model.jnt_dofadr[self.model.body_jntadr[self.robot_bodies[i]]]
+        q = self.data.qpos
+        q[adr:adr + 2] = pose.x, pose.y
+        q[adr + 3:adr + 7] = math.cos(pose.yaw / 2), 0.0, 0.0, math.sin(pose.yaw / 2)
+        self.data.qvel[dof:dof + 6] = 0.0
+        self.data.ctrl[self._actuators[i]] = 0.0
+        mujoco.mj_forward(self.model, self.data)  # sensors see the robot where it now is
+        self._readings = self._read_sensors()
 
     # ------------------------------------------------------------------ stepping
     def step(self, ticks: int = 1) -> None:

@@ -226,8 +226,11 @@ def test_segment_distance_matches_sampling():
 
 
 def test_wall_setback_formula():
-    assert geo.wall_setback(math.pi / 2) == pytest.approx(0.21 + 0.02)
-    assert geo.wall_setback(2 * math.pi) == geo.wall_setback(math.pi) == 0.22
+    # at 90 degrees the offset lines meet 0.21 m out: the clear radius (0.255 m) rules
+    assert geo.wall_setback(math.pi / 2) == geo.VERTEX_CLEAR_RADIUS_M == 0.255
+    assert geo.wall_setback(math.radians(75)) == pytest.approx(
+        0.21 / math.tan(math.radians(37.5)) + 0.02)
+    assert geo.wall_setback(2 * math.pi) == geo.wall_setback(math.pi) == 0.255
     assert geo.wall_setback(math.pi / 4) == pytest.approx(0.21 / math.tan(math.pi / 8) + 0.02)
     assert geo.lane_setback(math.pi / 2) == 0.16
 
@@ -344,9 +347,9 @@ BAD_SPECS = {
         "edges a-b and a-c meet at a at 30.0 degrees, less than MIN_ANGLE_DEG = 45",
     ),
     "short wall": (
-        _spec({"a": [0, 0], "b": [0.7, 0], "c": [0.7 * math.cos(0.8727), 0.7 * math.sin(0.8727)]},
+        _spec({"a": [0, 0], "b": [0.8, 0], "c": [0.8 * math.cos(0.8727), 0.8 * math.sin(0.8727)]},
               [["a", "b"], ["a", "c"]]),
-        "edge a-b is too short for a robot to follow at its angles: its left wall is 0.010 m",
+        "edge a-b is too short for a robot to follow at its angles: its left wall is 0.075 m",
     ),
     "wall at a vertex": (
         _spec({"a": [0, 0], "b": [3, 0], "w": [1, 0.25], "c": [1, 1.5], "d": [3, 1.5]},

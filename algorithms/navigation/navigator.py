@@ -19,8 +19,10 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
   its heading with the edge it came by: a straight edge leaves ``u`` at angle ``a`` and
   enters ``v`` at ``a + pi``, so the spoke nearest to that is the incoming one and the
   difference is odometry drift since leaving ``u``;
-* **leaving**: turn to the chosen spoke, follow it to its outer end, shift left by
-  ``lane_offset_m`` and find the lane ahead.
+* **leaving**: sidestep from the vertex centre to the left of the chosen spoke by
+  ``lane_offset_m`` and find the lane ahead. (Not along the spoke first: two robots
+  leaving the two ends of one edge at once would then face each other on its centre line,
+  where the collision rule stops both, seed 003 eq. (27) with ``beta = 0``.)
 
 Choices: the approach and departure shifts are open-loop odometry manoeuvres at 60
 degrees; the vertex-centre estimate has the accuracy of line following plus a 8 cm
@@ -50,6 +52,7 @@ class ArenaConventions:
     spoke_radius_m: float
     min_wall_run_m: float = 0.05
     max_seek_m: float = 0.40
+    clearance_m: float = 0.25
 
 
 class NavigatorState(Enum):
@@ -92,6 +95,8 @@ class Navigator:
         self._wall_run_start: float | None = None
         self._wall_seen = False
         self.vertex_detected = False
+        self._lane_start = 0.0
+        self._cleared = False
 
     # ---------------------------------------------------------------- control
     def begin_at_vertex(self) -> None:
@@ -104,8 +109,6 @@ class Navigator:
             raise RuntimeError(f"depart() needs the robot at a vertex, it is {self.state.value}")
         self._departed = angle % (2.0 * math.pi)
         self._plan = deque([
-            (Turn(angle, self.turn_rate), None),
-            (FollowLine(self.speed), None),
             *self._shift(angle, +1),
             (SeekLine(angle, self.speed, self.conv.max_seek_m), self._found_lane),
         ])
@@ -146,11 +149,17 @@ class Navigator:
         self._wall_seen = False
         self._wall_run_start = None
         self._lane = FollowLine(self.speed)
+        self._lane_start = self.odometry.distance_m
+        self._cleared = False
         self._plan = deque([(self._lane, self._lane_ended)])
 
     def _watch_wall(self, percept: Percept) -> None:
-        """Vertex detection: the left wall, once seen on this edge, disappears."""
+        """Vertex detection: the left wall, once seen on this edge, disappears. Also
+        reports ``clear_of_vertex`` once ``clearance_m`` along the lane (vertex entry)."""
         travelled = self.odometry.distance_m
+        if not self._cleared and travelled - self._lane_start >= self.conv.clearance_m:
+            self._cleared = True
+            self.events.append("clear_of_vertex")
         if percept.wall_left:
             if self._wall_run_start is None:
                 self._wall_run_start = travelled

@@ -69,8 +69,12 @@ LANE_END_RADIUS_M = 0.16
 #: SPOKE_RADIUS_M from the vertex centre (m), found by rotating in place.
 SPOKE_RADIUS_M = 0.12
 SPOKE_INNER_RADIUS_M = 0.03
-#: Walls start at least this far (along the edge) from each vertex centre (m).
-VERTEX_CLEAR_RADIUS_M = 0.22
+#: Walls start at least this far (along the edge) from each vertex centre (m). A robot
+#: detects a vertex where its left wall ends and, if another robot is on the vertex, waits
+#: there (mjswarm.embodied, vertex entry): its centre is then 0.26 m from the vertex centre
+#: and 0.17 m from the lane of a robot leaving on the neighbouring edge 90 degrees away,
+#: more than the 0.15 m two robot bodies need.
+VERTEX_CLEAR_RADIUS_M = 0.255
 #: Extra gap (m) beyond the point where the offset lines of neighbouring edges meet, used
 #: by :func:`wall_setback` and :func:`lane_setback` so neighbouring pieces never touch.
 SETBACK_MARGIN_M = 0.02
@@ -78,7 +82,7 @@ SETBACK_MARGIN_M = 0.02
 MIN_ANGLE_DEG = 45.0
 #: An edge is too short for a robot to follow if either wall, after the setbacks at both
 #: ends, is shorter than MIN_WALL_LENGTH_M, or the edge is shorter than MIN_EDGE_LENGTH_M.
-MIN_WALL_LENGTH_M = 0.10
+MIN_WALL_LENGTH_M = 0.08
 MIN_EDGE_LENGTH_M = 0.5
 #: A robot at a vertex centre must see no wall: IR range 0.10 m + Spark V radius 0.075 m.
 VERTEX_OPEN_RADIUS_M = 0.10 + 0.075

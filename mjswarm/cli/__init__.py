@@ -16,7 +16,7 @@ from mjswarm import __version__
 from mjswarm.errors import MjswarmError
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ("bench", "arena")
+SUBCOMMANDS = ("bench", "arena", "explore", "compare", "view")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,151 @@
+"""The one interface every exploration strategy implements: a per-robot mind.
+
+A strategy never sees true vertex ids nor the graph. At each vertex arrival the world
+calls :meth:`Strategy.on_vertex` with
+
+* ``beacon``: a :class:`Beacon` handle for the vertex the robot stands on, readable and
+  writable only during that call. The world owns one beacon per vertex (seed 003 drops a
+  beacon at the first visit; the experiments emulate it with a central station) and never
+  looks inside ``beacon.data``; it only reads ``beacon.id`` to map the strategy's beacon
+  names to arena vertices for metrics.
+* ``angles``: the incidence angles of the edges at this vertex as the robot measured them,
+  radians counter-clockwise from the common +x reference, in (0, 2*pi] (seed 003 section 2:
+  "the zero angle is represented by 2*pi"). Exact in the graph world; a few degrees off on
+  embodied robots, so strategies match angles by nearest value within
+  :data:`ANGLE_TOLERANCE` (edges at a vertex are at least 45 degrees apart).
+* ``arrived_by``: the measured angle, at this vertex, of the edge the robot arrived by;
+  ``None`` when it did not move since its previous call (the start, or after idling).
+
+It answers with a :class:`Decision`: leave along the edge at ``angle``, ``DONE``
+(completion declared) or ``IDLE`` (nothing to do now; the world calls again one time unit
+later with ``arrived_by=None``).
+
+Robots that arrive at one vertex at the same time are handled one after another, each
+seeing the beacon as the previous one left it, in *descending* robot index. Seed 003's
+Fig. 9 run fixes that order: its 10th update is R1 reaching v6 at the 5th step, so R2's
+update of each step comes first, and at v4 (both robots arrive at step 2) only R2-first
+reproduces the printed vertex sequences.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+TWO_PI = 2.0 * math.pi
+
+#: Largest mismatch (radians) between a measured angle and a stored one that still
+#: names the same edge; half the 45 degree minimum angle between edges at a vertex.
+ANGLE_TOLERANCE = math.radians(20.0)
+
+
+class AngleMismatch(ValueError):
+    """A measured angle matches no stored edge angle within the tolerance."""
+
+
+@dataclass(frozen=True, slots=True)
+class Decision:
+    """What a robot does after a vertex visit: ``go`` along ``angle``, ``done`` or ``idle``."""
+
+    action: str
+    angle: float | None = None
+
+
+DONE = Decision("done")
+IDLE = Decision("idle")
+
+
+def go(angle: float) -> Decision:
+    """Leave the vertex along the edge whose incidence angle is ``angle`` (radians)."""
+    return Decision("go", angle)
+
+
+class Beacon:
+    """A vertex's beacon as the robot sees it during one call.
+
+    ``id`` is ``None`` until the first visitor drops the beacon and names it (seed 003:
+    robot R1 names its beacons a1, a2, ...; see :mod:`algorithms.exploration.beacon_ids`).
+    ``data`` is whatever the strategy keeps there (for seed 003, the incidence matrix).
+    """
+
+    __slots__ = ("data", "id")
+
+    def __init__(self) -> None:
+        self.id: str | None = None
+        self.data: Any = None
+
+
+class Strategy(ABC):
+    """A per-robot exploration mind; one instance per robot.
+
+    ``index`` is the robot's 0-based index (R1 is index 0), ``n_robots`` the team size K,
+    ``rng`` a seeded generator for tie-breaking, or ``None`` for the canonical,
+    fully deterministic tie rules each strategy documents.
+    """
+
+    #: CLI name of the strategy.
+    name: ClassVar[str]
+
+    def __init__(self, index: int, n_robots: int, rng: np.random.Generator | None = None):
+        if n_robots < 1 or not 0 <= index < n_robots:
+            raise ValueError(f"robot index {index} out of range for {n_robots} robots")
+        self.index = index
+        self.n_robots = n_robots
+        self.rng = rng
+
+    @abstractmethod
+    def on_vertex(
+        self, beacon: Beacon, angles: Sequence[float], arrived_by: float | None
+    ) -> Decision:
+        """Handle an arrival (or a wake-up after idling) and decide what to do next."""
+
+    @abstractmethod
+    def map_edges(self) -> list[tuple[str, str]]:
+        """The robot's map: its known traversed edges as pairs of beacon ids."""
+
+
+def normalize_angle(angle: float) -> float:
+    """``angle`` (radians) mapped into (0, 2*pi], with 0 represented by 2*pi (seed 003)."""
+    a = math.fmod(angle, TWO_PI)
+    if a <= 0.0:
+        a += TWO_PI
+    return a
+
+
+def angle_gap(a: float, b: float) -> float:
+    """Smallest absolute difference between two angles (radians), in [0, pi]."""
+    d = abs(a - b) % TWO_PI
+    return min(d, TWO_PI - d)
+
+
+def match_angle(angle: float, stored: Sequence[float], tolerance: float = ANGLE_TOLERANCE) -> float:
+    """The stored angle nearest to a measured ``angle``; :class:`AngleMismatch` if none is
+    within ``tolerance`` (radians)."""
+    if angle in stored:
+        return angle
+    best = min(stored, key=lambda s: angle_gap(angle, s))
+    if angle_gap(angle, best) > tolerance:
+        raise AngleMismatch(
+            f"measured angle {math.degrees(angle):.1f} deg matches no edge within "
+            f"{math.degrees(tolerance):.0f} deg of {[round(math.degrees(s), 1) for s in stored]}"
+        )
+    return best
+
+
+def ccw_from(reference: float, angles: Sequence[float]) -> list[float]:
+    """``angles`` in counter-clockwise order starting just after ``reference``.
+
+    An angle equal to the reference comes last (a full turn). This is the preference
+    order of a robot's own new edges at a vertex (reference: the edge it arrived by; +x,
+    i.e. 2*pi, at the root), which reproduces seed 003's Fig. 9 run (DESIGN notes).
+    """
+    def turn(a: float) -> float:
+        d = (a - reference) % TWO_PI
+        return d if d > 1e-12 else TWO_PI
+
+    return sorted(angles, key=turn)

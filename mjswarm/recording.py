@@ -1,0 +1,558 @@
+"""Rerun recordings of runs, written headless to an ``.rrd`` file (issue 5, part 4).
+
+A :class:`Recorder` writes one rerun (0.41) recording: the arena as static data, every
+robot's pose, trail and sensor readings per control tick, and the rarer things (events,
+explored graphs, beacon contents, the radio graph) when they happen, plus a blueprint
+so the file opens ready to review (``mjswarm view FILE.rrd`` or ``rerun FILE.rrd``).
+No display is needed to write one. Ground truth (poses) is fine here: recordings are
+for reviewers, never read by controllers.
+
+Entity tree (all lengths in metres, angles in radians, speeds in m/s; the world frame
+is right-handed, z up, the floor at z = 0)::
+
+    arena/strips              Boxes3D, static: lane strips and vertex spokes
+    arena/walls               Boxes3D, static: corridor walls
+    arena/vertices            Points3D, static: vertex centres labelled with arena ids
+    robots/r<i>/pose          Transform3D per tick (x, y, yaw) + static Cylinders3D body
+    robots/r<i>/pose/heading  Arrows3D, static, in the robot frame: the heading
+    robots/r<i>/trail         LineStrips3D per tick: the segment driven since the last tick
+    robots/r<i>/speed         Scalars per tick: commanded linear speed
+    robots/r<i>/sensors/line  Scalars per tick, 3 series: line rangefinders (left, centre, right)
+    robots/r<i>/sensors/ir    Scalars per tick, 3 series: IR distances, NaN = nothing seen
+    robots/r<i>/bearings/r<j> Scalars (drawn as points) at ticks where r<i> sees r<j>
+    map/r<i>                  GraphNodes + GraphEdges: robot i's explored graph
+    beacons/<vertex>          TextDocument: the beacon's contents (beacon-side vertex id)
+    radio/graph               GraphNodes + GraphEdges: who hears whom
+    radio/links               LineStrips3D: the same edges drawn between the robots
+    radio/truth               TextDocument: ground truth and the robots' beliefs
+    events                    TextLog: run-wide events (completion, ...)
+    events/r<i>               TextLog: robot i's events (vertex visits, speed changes)
+
+Everything not static is on two timelines: ``step`` (control tick, a sequence) and
+``sim_time`` (simulated seconds, a duration). The SDK's own ``log_tick``/``log_time``
+timelines are switched off so a recording carries only simulation time.
+
+Per-tick data is buffered in numpy arrays and sent with ``send_columns`` every
+``chunk_ticks`` ticks and at :meth:`Recorder.close`; per-call logging would cost far more
+per tick. Choices:
+
+* The trail is one short segment per tick (previous position -> current position); the
+  blueprint shows the last ``trail_window_s`` of segments (a per-entity visible time
+  range), which is rerun's documented way to draw trails and costs 2 points per tick
+  instead of a whole strip.
+* Bearings are sparse (a robot sees few others), so each observed pair gets its own
+  series, drawn as points, sent only at the ticks of the observations.
+* Graph views (``map/*``, ``radio/graph``) use the positions given, with y negated:
+  rerun's graph view draws y downwards, so the graphs then look like the top view of
+  the arena.
+* An explored graph identical to the one last logged for that robot is not logged again.
+"""
+
+from __future__ import annotations
+
+import colorsys
+import os
+import shutil
+import subprocess
+import sys
+import uuid
+from collections.abc import Mapping, Sequence
+from importlib.util import find_spec
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+from mjswarm.arena.builder import arena_primitives
+from mjswarm.arena.spec import ArenaSpec
+from mjswarm.errors import MjswarmError, one_line
+from mjswarm.robot import IR_SENSORS, LINE_SENSORS
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
+
+APPLICATION_ID = "mjswarm"
+#: Robot body height for drawing (m): the Spark V is 7 cm tall (DESIGN.md).
+ROBOT_HEIGHT_M = 0.07
+#: Ticks buffered before a columnar send.
+CHUNK_TICKS = 500
+#: How much trail the blueprint shows behind each robot (simulated s).
+TRAIL_WINDOW_S = 30.0
+#: Above this many robots the blueprint shows all explored graphs in one graph view
+#: instead of one tab per robot.
+MAP_TAB_LIMIT = 8
+_TRAIL_Z_M = 0.004
+_VERTEX_Z_M = 0.006
+_STRIP_COLOR = (30, 30, 30, 255)
+_WALL_COLOR = (150, 150, 165, 140)
+_VERTEX_COLOR = (220, 40, 40, 255)
+_ROOT_COLOR = (240, 190, 20, 255)
+_AGREE_COLOR = (40, 170, 60, 255)
+_DISAGREE_COLOR = (220, 40, 40, 255)
+_NO_BELIEF_COLOR = (140, 140, 140, 255)
+
+
+def robot_color(i: int) -> tuple[int, int, int, int]:
+    """A distinct RGBA colour for robot ``i`` (golden-ratio hue steps)."""
+    r, g, b = colorsys.hsv_to_rgb((i * 0.618033988749895) % 1.0, 0.75, 0.95)
+    return int(r * 255), int(g * 255), int(b * 255), 255
+
+
+def rerun_command() -> list[str]:
+    """The argv prefix that runs the ``rerun`` CLI shipped with rerun-sdk.
+
+    The binary lives in the ``rerun_cli`` package next to the SDK; ``rerun`` on PATH is
+    the fallback. Raises :class:`MjswarmError` if neither exists.
+    """
+    spec = find_spec("rerun_cli")
+    if spec is not None and spec.origin is not None:
+        binary = Path(spec.origin).parent / ("rerun.exe" if sys.platform == "win32" else "rerun")
+        if binary.is_file():
+            return [str(binary)]
+    on_path = shutil.which("rerun")
+    if on_path is None:
+        raise MjswarmError("the rerun CLI was not found (is rerun-sdk installed?)")
+    return [on_path]
+
+
+def has_display() -> bool:
+    """Whether a viewer window can open: on Linux and other X11/Wayland systems, DISPLAY
+    or WAYLAND_DISPLAY must be set; macOS and Windows always have a display."""
+    if sys.platform in ("darwin", "win32"):
+        return True
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def open_viewer(path: str | Path) -> int:
+    """Open the recording at ``path`` in the rerun viewer; returns the viewer's exit status.
+
+    Blocks until the viewer window is closed. Raises :class:`MjswarmError` (one line,
+    at once) if the file is missing or not an ``.rrd`` recording (rerun's files start
+    with ``RRF``), or if there is no display.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise MjswarmError(f"no recording at {path}")
+    with path.open("rb") as f:
+        if f.read(3) != b"RRF":
+            raise MjswarmError(f"{path} is not a rerun .rrd recording")
+    if not has_display():
+        raise MjswarmError(
+            f"no display (DISPLAY and WAYLAND_DISPLAY are unset), cannot open the viewer; "
+            f"copy {path} to a machine with a display and run `mjswarm view {path.name}`"
+        )
+    return subprocess.call([*rerun_command(), str(path)])
+
+
+def _yaw_quaternions(yaw: np.ndarray) -> np.ndarray:
+    """Quaternions (x, y, z, w: rerun's order) of rotations by ``yaw`` (rad) about +z."""
+    half = np.asarray(yaw, dtype=float) / 2.0
+    quat = np.zeros(half.shape + (4,))
+    quat[..., 2] = np.sin(half)
+    quat[..., 3] = np.cos(half)
+    return quat
+
+
+def _segment_boxes(segments, width_m: float, height_m: float, z0_m: float):
+    """Centres, half sizes and yaw quaternions of boxes ``width_m`` x ``height_m`` along
+    the given segments (objects with ``.start`` and ``.end`` (x, y) in m), base at z0."""
+    start = np.array([s.start for s in segments], dtype=float).reshape(-1, 2)
+    end = np.array([s.end for s in segments], dtype=float).reshape(-1, 2)
+    delta = end - start
+    centres = np.column_stack([(start + end) / 2.0, np.full(len(start), z0_m + height_m / 2.0)])
+    half = np.column_stack([
+        np.hypot(delta[:, 0], delta[:, 1]) / 2.0,
+        np.full(len(start), width_m / 2.0),
+        np.full(len(start), height_m / 2.0),
+    ])
+    return centres, half, _yaw_quaternions(np.arctan2(delta[:, 1], delta[:, 0]))
+
+
+class Recorder:
+    """Writes a run to a rerun ``.rrd`` file; see the module docstring for the tree.
+
+    Args:
+        path: the ``.rrd`` file to write (its directory must exist).
+        arena: the arena the run happens in (drawn as static data).
+        n_robots: team size; robots are ``r0 .. r{n-1}``.
+        robot_radius_m: body radius for drawing (m).
+        chunk_ticks: ticks buffered between columnar sends.
+        trail_window_s: simulated seconds of trail the blueprint shows.
+
+    Raises :class:`MjswarmError` (one line) if the file cannot be created or a
+    parameter is impossible. Use as a context manager or call :meth:`close`.
+    """
+
+    def __init__(
+        self,
+        path: str | Path,
+        arena: ArenaSpec,
+        n_robots: int,
+        robot_radius_m: float = 0.075,
+        *,
+        chunk_ticks: int = CHUNK_TICKS,
+        trail_window_s: float = TRAIL_WINDOW_S,
+    ) -> None:
+        if int(n_robots) != n_robots or n_robots < 1:
+            raise MjswarmError(f"a recording needs at least 1 robot, got {n_robots}")
+        if not robot_radius_m > 0.0:
+            raise MjswarmError(f"robot radius must be > 0 m, got {robot_radius_m}")
+        if int(chunk_ticks) != chunk_ticks or chunk_ticks < 1:
+            raise MjswarmError(f"chunk_ticks must be a whole number >= 1, got {chunk_ticks}")
+        if not trail_window_s > 0.0:
+            raise MjswarmError(f"trail window must be > 0 s, got {trail_window_s}")
+        self.path = Path(path)
+        self.n_robots = n = int(n_robots)
+        self._chunk = int(chunk_ticks)
+        if self.path.is_dir():
+            raise MjswarmError(f"cannot write recording {self.path}: it is a directory")
+        if not self.path.parent.is_dir():
+            raise MjswarmError(
+                f"cannot write recording {self.path}: directory {self.path.parent} does not exist"
+            )
+        self._stream = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
+        try:
+            self._stream.save(self.path)
+        except RuntimeError as exc:
+            raise MjswarmError(f"cannot write recording {self.path}: {one_line(exc)}") from None
+        self._stream.set_log_tick_enabled(False)
+        self._stream.set_log_time_enabled(False)
+        self._stream.send_recording_name(f"{arena.name}, {n} robots")
+        self._stream.send_blueprint(_blueprint(arena, n, trail_window_s))
+        self._closed = False
+
+        b = self._chunk
+        self._rows = 0
+        self._steps = np.zeros(b, dtype=np.int64)
+        self._times = np.zeros(b)
+        self._poses = np.zeros((b, n, 3))
+        self._line = np.zeros((b, n, 3))
+        self._ir = np.zeros((b, n, 3))
+        self._speed = np.zeros((b, n))
+        self._bearing_rows: list[int] = []
+        self._bearing_pairs: list[int] = []  # observer * n + other
+        self._bearing_values: list[float] = []
+        self._bearing_series: set[int] = set()
+        self._trail_from: np.ndarray | None = None  # (n, 2): last position already sent
+        self._latest_xy: np.ndarray | None = None  # (n, 2): last position logged
+        self._last_map: dict[int, tuple] = {}
+
+        self._log_static(arena, float(robot_radius_m))
+
+    # --- static data -------------------------------------------------------------------
+
+    def _log_static(self, arena: ArenaSpec, radius_m: float) -> None:
+        log = self._stream.log
+        log("/", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+        strips, walls = arena_primitives(arena)
+        if strips:
+            c, h, q = _segment_boxes(strips, strips[0].width_m, strips[0].thickness_m, 0.0)
+            log("arena/strips", rr.Boxes3D(centers=c, half_sizes=h, quaternions=q,
+                                           colors=_STRIP_COLOR, fill_mode="solid"), static=True)
+        if walls:
+            c, h, q = _segment_boxes(walls, walls[0].thickness_m, walls[0].height_m, 0.0)
+            log("arena/walls", rr.Boxes3D(centers=c, half_sizes=h, quaternions=q,
+                                          colors=_WALL_COLOR, fill_mode="solid"), static=True)
+        ids = list(arena.vertices)
+        log("arena/vertices", rr.Points3D(
+            [(x, y, _VERTEX_Z_M) for x, y in arena.vertices.values()],
+            labels=ids, radii=0.015, show_labels=True,
+            colors=[_ROOT_COLOR if v == arena.root else _VERTEX_COLOR for v in ids],
+        ), static=True)
+        for i in range(self.n_robots):
+            color = robot_color(i)
+            log(f"robots/r{i}/pose", rr.Cylinders3D(
+                lengths=ROBOT_HEIGHT_M, radii=radius_m, centers=(0.0, 0.0, ROBOT_HEIGHT_M / 2),
+                colors=color, labels=f"r{i}", fill_mode="solid",
+            ), static=True)
+            log(f"robots/r{i}/pose/heading", rr.Arrows3D(
+                origins=(0.0, 0.0, ROBOT_HEIGHT_M + 0.005), vectors=(1.5 * radius_m, 0.0, 0.0),
+                colors=(255, 255, 255, 255), radii=0.006,
+            ), static=True)
+            log(f"robots/r{i}/trail", rr.LineStrips3D.from_fields(colors=color, radii=0.004),
+                static=True)  # style only: static strips would hide the temporal ones
+            log(f"robots/r{i}/speed", rr.SeriesLines(names=f"r{i}", colors=color), static=True)
+            for kind, names in (("line", LINE_SENSORS), ("ir", IR_SENSORS)):
+                log(f"robots/r{i}/sensors/{kind}",
+                    rr.SeriesLines(names=[f"r{i} {s}" for s in names]), static=True)
+
+    # --- per tick ----------------------------------------------------------------------
+
+    def log_tick(
+        self,
+        step: int,
+        sim_time_s: float,
+        poses: np.ndarray,
+        line: np.ndarray,
+        ir: np.ndarray,
+        speed: np.ndarray,
+        bearings: Sequence[Sequence[tuple[int, float]]],
+    ) -> None:
+        """Buffer one control tick; sends a chunk every ``chunk_ticks`` ticks.
+
+        Args:
+            step: control tick number.
+            sim_time_s: simulated time (s).
+            poses: (N, 3) x (m), y (m), yaw (rad) per robot.
+            line: (N, 3) line rangefinder readings (m), order of ``robot.LINE_SENSORS``.
+            ir: (N, 3) IR distances (m), NaN = nothing, order of ``robot.IR_SENSORS``.
+            speed: (N,) commanded linear speed (m/s).
+            bearings: per robot, the (other robot, bearing in rad) pairs it sees.
+        """
+        self._check_open()
+        n = self.n_robots
+        for name, value, shape in (("poses", poses, (n, 3)), ("line", line, (n, 3)),
+                                   ("ir", ir, (n, 3)), ("speed", speed, (n,))):
+            if np.shape(value) != shape:
+                raise ValueError(f"log_tick: {name} has shape {np.shape(value)}, expected {shape}")
+        if len(bearings) != n:
+            raise ValueError(f"log_tick: bearings has {len(bearings)} entries, expected {n}")
+        k = self._rows
+        self._steps[k] = step
+        self._times[k] = sim_time_s
+        self._poses[k] = poses
+        self._line[k] = line
+        self._ir[k] = ir
+        self._speed[k] = speed
+        for i, seen in enumerate(bearings):
+            for j, bearing in seen:
+                self._bearing_rows.append(k)
+                self._bearing_pairs.append(i * n + j)
+                self._bearing_values.append(bearing)
+        self._rows = k + 1
+        if self._rows == self._chunk:
+            self._send_ticks()
+
+    def _send_ticks(self) -> None:
+        """Send the buffered ticks as columns (one ``send_columns`` per entity)."""
+        k, n = self._rows, self.n_robots
+        if k == 0:
+            return
+        send = self._stream.send_columns
+        # rerun may keep the arrays it is given and encode them later (zero copy), so it
+        # gets copies, never views of the buffers that the next ticks overwrite.
+        steps, times = self._steps[:k].copy(), self._times[:k].copy()
+        speed, line, ir = self._speed[:k].copy(), self._line[:k].copy(), self._ir[:k].copy()
+        index = [rr.TimeColumn("step", sequence=steps), rr.TimeColumn("sim_time", duration=times)]
+        xy = self._poses[:k, :, :2].copy()
+        translation = np.concatenate([xy, np.zeros((k, n, 1))], axis=2)
+        quaternion = _yaw_quaternions(self._poses[:k, :, 2])
+        start = np.concatenate([(xy[0] if self._trail_from is None else self._trail_from)[None],
+                                xy[:-1]])
+        trail = np.full((k, n, 2, 3), _TRAIL_Z_M)
+        trail[:, :, 0, :2] = start
+        trail[:, :, 1, :2] = xy
+        for i in range(n):
+            robot = f"robots/r{i}"
+            send(f"{robot}/pose", index, rr.Transform3D.columns(
+                translation=translation[:, i], quaternion=quaternion[:, i]))
+            send(f"{robot}/trail", index, rr.LineStrips3D.columns(strips=trail[:, i]))
+            send(f"{robot}/speed", index, rr.Scalars.columns(scalars=speed[:, i]))
+            send(f"{robot}/sensors/line", index, rr.Scalars.columns(scalars=line[:, i]))
+            send(f"{robot}/sensors/ir", index, rr.Scalars.columns(scalars=ir[:, i]))
+        self._send_bearings(steps, times)
+        self._trail_from = self._latest_xy = xy[-1]
+        self._rows = 0
+
+    def _send_bearings(self, steps: np.ndarray, times: np.ndarray) -> None:
+        if not self._bearing_rows:
+            return
+        n = self.n_robots
+        rows = np.asarray(self._bearing_rows)
+        pairs = np.asarray(self._bearing_pairs)
+        values = np.asarray(self._bearing_values, dtype=float)
+        order = np.argsort(pairs, kind="stable")  # keeps each pair's rows in time order
+        rows, pairs, values = rows[order], pairs[order], values[order]
+        cuts = np.flatnonzero(np.diff(pairs)) + 1
+        for group in np.split(np.arange(len(pairs)), cuts):
+            pair = int(pairs[group[0]])
+            i, j = divmod(pair, n)
+            entity = f"robots/r{i}/bearings/r{j}"
+            if pair not in self._bearing_series:
+                self._bearing_series.add(pair)
+                self._stream.log(entity, rr.SeriesPoints(
+                    names=f"r{i} sees r{j}", colors=robot_color(j), marker_sizes=2.0),
+                    static=True)
+            r = rows[group]
+            self._stream.send_columns(
+                entity,
+                [rr.TimeColumn("step", sequence=steps[r]),
+                 rr.TimeColumn("sim_time", duration=times[r])],
+                rr.Scalars.columns(scalars=values[group]),
+            )
+        self._bearing_rows.clear()
+        self._bearing_pairs.clear()
+        self._bearing_values.clear()
+
+    # --- events ------------------------------------------------------------------------
+
+    def _at(self, step: int, sim_time_s: float) -> None:
+        self._check_open()
+        self._stream.set_time("step", sequence=step)
+        self._stream.set_time("sim_time", duration=sim_time_s)
+
+    def log_event(self, step: int, sim_time_s: float, text: str, robot: int | None = None) -> None:
+        """A line in the event log (``events``, or ``events/r<robot>`` for a robot's event)."""
+        self._at(step, sim_time_s)
+        if robot is None:
+            self._stream.log("events", rr.TextLog(text, level="INFO"))
+        else:
+            self._stream.log(f"events/r{robot}", rr.TextLog(f"r{robot}: {text}", level="INFO"))
+
+    def log_explored_graph(
+        self,
+        step: int,
+        sim_time_s: float,
+        robot: int,
+        nodes: Mapping[str, tuple[float, float]],
+        edges: Sequence[tuple[str, str]],
+    ) -> None:
+        """Robot ``robot``'s explored graph: node id -> (x, y) in m, and undirected edges.
+
+        Skipped when identical to the graph last logged for this robot.
+        """
+        key = (tuple(nodes.items()), tuple(edges))
+        if self._last_map.get(robot) == key:
+            return
+        self._last_map[robot] = key
+        self._at(step, sim_time_s)
+        ids = list(nodes)
+        self._stream.log(
+            f"map/r{robot}",
+            rr.GraphNodes(ids, positions=[(x, -y) for x, y in nodes.values()], labels=ids,
+                          colors=robot_color(robot)),
+            rr.GraphEdges(list(edges), graph_type="undirected"),
+        )
+
+    def log_beacon(self, step: int, sim_time_s: float, vertex: str, text: str) -> None:
+        """The contents of the beacon at ``vertex`` (the beacon's own id), as text."""
+        self._at(step, sim_time_s)
+        self._stream.log(f"beacons/{rr.escape_entity_path_part(vertex)}", rr.TextDocument(text))
+
+    def log_radio(
+        self,
+        step: int,
+        sim_time_s: float,
+        edges: Sequence[tuple[int, int]],
+        beliefs: Mapping[int, str] | None = None,
+        truth: str | None = None,
+    ) -> None:
+        """The radio graph (robot index pairs in range), drawn at the robots' positions.
+
+        With ``beliefs`` (robot -> its current answer, e.g. whether the team is
+        biconnected) and ``truth`` (the ground-truth answer), nodes are green where the
+        belief equals the truth, red where it differs, grey without a belief.
+        """
+        self._at(step, sim_time_s)
+        n = self.n_robots
+        for a, b in edges:
+            if not (0 <= a < n and 0 <= b < n):
+                raise ValueError(f"log_radio: edge ({a}, {b}) names a robot outside 0..{n - 1}")
+        beliefs = dict(beliefs or {})
+        ids = [f"r{i}" for i in range(n)]
+        labels = [f"r{i}: {beliefs[i]}" if i in beliefs else f"r{i}" for i in range(n)]
+        if truth is None:
+            colors = [robot_color(i) for i in range(n)]
+        else:
+            colors = [_NO_BELIEF_COLOR if i not in beliefs
+                      else _AGREE_COLOR if beliefs[i] == truth else _DISAGREE_COLOR
+                      for i in range(n)]
+        xy = self._positions()
+        self._stream.log("radio/graph",
+                         rr.GraphNodes(ids, positions=None if xy is None else xy * (1.0, -1.0),
+                                       labels=labels, colors=colors),
+                         rr.GraphEdges([(ids[a], ids[b]) for a, b in edges],
+                                       graph_type="undirected"))
+        if xy is not None:
+            z = ROBOT_HEIGHT_M + 0.01
+            self._stream.log("radio/links", rr.LineStrips3D(
+                [[(*xy[a], z), (*xy[b], z)] for a, b in edges],
+                colors=(60, 140, 255, 200), radii=0.003))
+        if truth is not None or beliefs:
+            lines = [] if truth is None else [f"truth: {truth}"]
+            lines += [f"r{i}: {beliefs[i]}" for i in sorted(beliefs)]
+            self._stream.log("radio/truth", rr.TextDocument("\n".join(lines)))
+
+    def _positions(self) -> np.ndarray | None:
+        """(N, 2) latest logged robot positions (m), buffered or sent; None before any."""
+        if self._rows:
+            return self._poses[self._rows - 1, :, :2].copy()
+        return self._latest_xy
+
+    # --- lifetime ----------------------------------------------------------------------
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise RuntimeError(f"recorder for {self.path} is closed")
+
+    def close(self) -> None:
+        """Send buffered ticks, flush and finish the file. Closing twice is harmless."""
+        if self._closed:
+            return
+        self._send_ticks()
+        self._stream.flush()
+        self._stream.disconnect()
+        self._closed = True
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.close()
+
+
+def _blueprint(arena: ArenaSpec, n_robots: int, trail_window_s: float) -> rrb.Blueprint:
+    """The layout the file opens with: 3-D arena + event log on the left; explored
+    graphs, radio graph and beacons on the top right; time series on the bottom right."""
+    robots = range(n_robots)
+    xy = np.array(list(arena.vertices.values()))
+    centre = (xy.min(axis=0) + xy.max(axis=0)) / 2.0
+    extent = float(max(np.ptp(xy, axis=0).max(), 1.0))
+    trail_range = rrb.VisibleTimeRanges(rrb.VisibleTimeRange(
+        "sim_time",
+        start=rrb.TimeRangeBoundary.cursor_relative(seconds=-trail_window_s),
+        end=rrb.TimeRangeBoundary.cursor_relative(),
+    ))
+    scene = rrb.Spatial3DView(
+        name="arena",
+        origin="/",
+        contents=["+ /arena/**", "+ /robots/**", "+ /radio/links"],
+        overrides={f"/robots/r{i}/trail": trail_range for i in robots},
+        eye_controls=rrb.EyeControls3D(
+            position=(centre[0], centre[1] - 0.8 * extent, 1.1 * extent),
+            look_target=(centre[0], centre[1], 0.0),
+            eye_up=(0.0, 0.0, 1.0),
+        ),
+    )
+    if n_robots <= MAP_TAB_LIMIT:
+        maps = [rrb.GraphView(name=f"map r{i}", origin=f"/map/r{i}") for i in robots]
+    else:
+        maps = [rrb.GraphView(name="maps", origin="/map")]
+    graphs = rrb.Tabs(
+        *maps,
+        rrb.GraphView(name="radio", origin="/radio/graph"),
+        rrb.TextDocumentView(name="beacons", origin="/beacons"),
+        rrb.TextDocumentView(name="radio truth", origin="/radio/truth"),
+    )
+    series = rrb.Tabs(
+        rrb.TimeSeriesView(name="speed (m/s)", origin="/robots",
+                           contents=[f"+ /robots/r{i}/speed" for i in robots]),
+        rrb.TimeSeriesView(name="line sensors (m)", origin="/robots",
+                           contents=[f"+ /robots/r{i}/sensors/line" for i in robots]),
+        rrb.TimeSeriesView(name="IR (m)", origin="/robots",
+                           contents=[f"+ /robots/r{i}/sensors/ir" for i in robots]),
+        rrb.TimeSeriesView(name="bearings (rad)", origin="/robots",
+                           contents=[f"+ /robots/r{i}/bearings/**" for i in robots]),
+    )
+    return rrb.Blueprint(
+        rrb.Horizontal(
+            rrb.Vertical(scene, rrb.TextLogView(name="events", origin="/events"),
+                         row_shares=[3, 1]),
+            rrb.Vertical(graphs, series),
+            column_shares=[3, 2],
+        ),
+        rrb.TimePanel(timeline="sim_time"),
+        collapse_panels=False,
+    )
