@@ -7,7 +7,9 @@ view and changes only its own linear speed ``S_k``:
   we estimate the rate by a least-squares slope over the last ``window`` bearings and call
   it zero when ``|rate| < zero_rate``;
 * eq. (27), on detection: ``S_k = 0`` if ``beta_kp = 0`` (``R_p`` ahead on the same
-  lane; we take ``|beta| < same_lane``), else ``S_k = S_k - eps_k S``;
+  lane; we take ``|beta| < same_lane``, 5 degrees: a robot on the opposite lane, 0.18 m to
+  the right, is seen at least 10 degrees off within the sensor's 1 m), else
+  ``S_k = S_k - eps_k S``;
 * eq. (33), when ``R_p`` leaves the field of view and a reduction for it applies:
   ``S_k = S`` if ``S_k = 0``, else ``S_k = S_k + eps_k S``;
 * eq. (34), when ``R_k`` crosses the common vertex: ``S_k = S``, and the pending
@@ -31,6 +33,7 @@ Choices where the paper is silent (see also :class:`CollisionRule`):
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import deque
 from dataclasses import dataclass, field
@@ -63,7 +66,7 @@ def satisfies_28(eps: list[float]) -> bool:
     chain = []
     for e in eps:
         chain += [e, (k - 1) * e]
-    for (a, b), i in zip(zip(chain, chain[1:]), range(len(chain) - 1)):
+    for (a, b), i in zip(itertools.pairwise(chain), range(len(chain) - 1)):
         same_robot = i % 2 == 0
         if not (a <= b if same_robot else a < b):
             return False
@@ -86,7 +89,7 @@ class CollisionRule:
     initial_speed: float
     epsilon: float
     zero_rate: float = 0.02
-    same_lane: float = math.radians(8.0)
+    same_lane: float = math.radians(5.0)
     window: int = 10
     dt: float = 0.02
     speed: float = field(init=False)

@@ -36,12 +36,15 @@ def calibration(geom: RobotGeometry) -> RobotCalibration:
     )
 
 
-def conventions() -> ArenaConventions:
-    """The arena marks the robots read (:mod:`mjswarm.arena.geometry`)."""
+def conventions(geom: RobotGeometry) -> ArenaConventions:
+    """The arena marks the robots read (:mod:`mjswarm.arena.geometry`), and where the
+    corridor wall appears to a robot of this geometry on its lane."""
+    wall_face = geometry.CORRIDOR_HALF_WIDTH_M - geometry.WALL_THICKNESS_M / 2
     return ArenaConventions(
         lane_offset_m=geometry.LANE_OFFSET_M,
         spoke_inner_radius_m=geometry.SPOKE_INNER_RADIUS_M,
         spoke_radius_m=geometry.SPOKE_RADIUS_M,
+        wall_distance_m=wall_face - geometry.LANE_OFFSET_M - geom.ir_side_offset_m,
     )
 
 
@@ -69,7 +72,7 @@ class NavigationDriver:
     def __init__(self, sim: Simulation, headings: Sequence[float], speed_m_s: float = 0.05,
                  turn_rate_rad_s: float = 1.0) -> None:
         self.sim = sim
-        cal, conv = calibration(sim.geometry), conventions()
+        cal, conv = calibration(sim.geometry), conventions(sim.geometry)
         self.navigators = [Navigator(cal, conv, h, speed_m_s, turn_rate_rad_s) for h in headings]
         self._v = np.zeros(sim.n)
         self._w = np.zeros(sim.n)

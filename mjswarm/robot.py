@@ -42,6 +42,7 @@ class RobotGeometry:
         line_sensor_ahead_m: how far ahead of the axle the line sensors look.
         line_sensor_spacing_m: lateral distance between neighbouring line sensors.
         ir_range_m: IR proximity cutoff (beyond it: "nothing").
+        ir_side_offset_m: lateral distance from the robot's centre to the side IR sensors.
     """
 
     wheel_radius_m: float
@@ -52,6 +53,7 @@ class RobotGeometry:
     line_sensor_ahead_m: float
     line_sensor_spacing_m: float
     ir_range_m: float
+    ir_side_offset_m: float
 
     @property
     def max_speed_m_s(self) -> float:
@@ -99,4 +101,5 @@ def measure_geometry(model: mujoco.MjModel, prefix: str = "") -> RobotGeometry:
         line_sensor_ahead_m=float(line[1][0]),
         line_sensor_spacing_m=float(abs(line[0][1] - line[1][1])),
         ir_range_m=float(model.sensor(prefix + IR_SENSORS[0]).cutoff[0]),
+        ir_side_offset_m=float(model.site(prefix + IR_SENSORS[0]).pos[1]),
     )

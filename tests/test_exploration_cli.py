@@ -31,7 +31,8 @@ def test_explore_fig9_json_to_stdout(capsys):
 @pytest.mark.parametrize("strategy", list(STRATEGIES))
 def test_explore_every_strategy_on_arena2_writes_json_file(strategy, tmp_path, capsys):
     path = tmp_path / "run.json"
-    assert main(["explore", "--arena", "arena2", "--robots", "4", "--strategy", strategy,
+    assert main(["explore", "--world", "graph", "--arena", "arena2", "--robots", "4",
+                 "--strategy", strategy,
                  "--seed", "3", "--json", str(path)]) == 0
     text = capsys.readouterr().out
     assert "completed: R" in text and "equal to the arena's" in text
@@ -41,7 +42,8 @@ def test_explore_every_strategy_on_arena2_writes_json_file(strategy, tmp_path, c
 
 
 def test_explore_root_and_edge_time_options(capsys):
-    assert main(["explore", "--arena", "lattice:4x4", "--robots", "5", "--root", "v0_1",
+    assert main(["explore", "--world", "graph", "--arena", "lattice:4x4", "--robots", "5",
+                 "--root", "v0_1",
                  "--edge-time", "length", "--json", "-"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["root"] == "v0_1" and out["edge_time"] == "length" and out["makespan"] == 10

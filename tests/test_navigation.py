@@ -9,6 +9,7 @@ own sensing decides where it goes; ground truth only checks the outcome.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import networkx as nx
@@ -55,7 +56,7 @@ def run_walk(name: str, legs: int | None = None) -> dict:
             driver.step()
         raise AssertionError(f"robot did not reach a vertex; events {nav.events[-3:]}")
 
-    for here, there in zip(walk, walk[1:]):
+    for here, there in itertools.pairwise(walk):
         record["edge_times"].append(run_until_at_vertex())
         pose = sim.poses()[0]
         record["arrival_errors"].append(math.dist(pose[:2], spec.vertices[here]))
@@ -90,7 +91,7 @@ def test_time_per_edge_matches_length_and_speed(name):
     lanes = {strip.travel: math.dist(strip.start, strip.end)
              for strip in lane_strips(record["spec"])}
     walk = record["walk"]
-    for (u, v), t in zip(zip(walk, walk[1:]), record["edge_times"][1:]):
+    for (u, v), t in zip(itertools.pairwise(walk), record["edge_times"][1:]):
         assert t * SPEED_M_S == pytest.approx(lanes[(u, v)], abs=0.03)
 
 

@@ -50,9 +50,10 @@ class ArenaConventions:
     lane_offset_m: float
     spoke_inner_radius_m: float
     spoke_radius_m: float
+    wall_distance_m: float  # left IR reading of the corridor wall from the lane
+    wall_tolerance_m: float = 0.012
     min_wall_run_m: float = 0.05
     max_seek_m: float = 0.40
-    clearance_m: float = 0.25
 
 
 class NavigatorState(Enum):
@@ -95,8 +96,6 @@ class Navigator:
         self._wall_run_start: float | None = None
         self._wall_seen = False
         self.vertex_detected = False
-        self._lane_start = 0.0
-        self._cleared = False
 
     # ---------------------------------------------------------------- control
     def begin_at_vertex(self) -> None:
@@ -130,6 +129,20 @@ class Navigator:
                 on_done(motion)
         return 0.0, 0.0
 
+    @property
+    def in_corridor(self) -> bool:
+        """On an edge's lane and has seen its left wall (``min_wall_run_m`` of it)."""
+        return self.state is NavigatorState.ON_EDGE and self._wall_seen
+
+    @property
+    def on_lane(self) -> bool:
+        """Driving along an edge on its lane: following it, or looking for it straight ahead
+        after leaving a vertex (the sidestep is done)."""
+        if self.state is NavigatorState.ON_EDGE:
+            return True
+        return (self.state is NavigatorState.LEAVING and bool(self._plan)
+                and isinstance(self._plan[0][0], SeekLine))
+
     # ---------------------------------------------------------------- plans
     def _shift(self, heading: float, side: int) -> list:
         """Sidestep ``lane_offset_m`` to the left (side=+1) or right (-1) of ``heading``."""
@@ -149,18 +162,16 @@ class Navigator:
         self._wall_seen = False
         self._wall_run_start = None
         self._lane = FollowLine(self.speed)
-        self._lane_start = self.odometry.distance_m
-        self._cleared = False
         self._plan = deque([(self._lane, self._lane_ended)])
 
     def _watch_wall(self, percept: Percept) -> None:
-        """Vertex detection: the left wall, once seen on this edge, disappears. Also
-        reports ``clear_of_vertex`` once ``clearance_m`` along the lane (vertex entry)."""
+        """Vertex detection: the left wall, once seen on this edge, disappears.
+
+        A wall is an IR reading within ``wall_tolerance_m`` of ``wall_distance_m``, the
+        distance from the lane to the corridor wall: a robot passing on the left is seen
+        at other, changing distances and is not taken for a wall (NaN never matches)."""
         travelled = self.odometry.distance_m
-        if not self._cleared and travelled - self._lane_start >= self.conv.clearance_m:
-            self._cleared = True
-            self.events.append("clear_of_vertex")
-        if percept.wall_left:
+        if abs(percept.ir[0] - self.conv.wall_distance_m) <= self.conv.wall_tolerance_m:
             if self._wall_run_start is None:
                 self._wall_run_start = travelled
             if travelled - self._wall_run_start >= self.conv.min_wall_run_m:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 
@@ -19,11 +18,6 @@ class Percept:
     line: tuple[bool, bool, bool]
     ir: tuple[float, float, float]
     encoders: tuple[float, float]
-
-    @property
-    def wall_left(self) -> bool:
-        """The left IR sensor sees an obstacle within range."""
-        return not math.isnan(self.ir[0])
 
     @property
     def any_line(self) -> bool:

@@ -28,6 +28,7 @@ from pathlib import Path
 
 import networkx as nx
 import numpy as np
+
 try:
     import tomllib
 except ModuleNotFoundError:  # Python 3.10

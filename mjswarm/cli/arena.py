@@ -6,12 +6,8 @@ anything :func:`mjswarm.arena.load_arena` accepts.
 
 from __future__ import annotations
 
-import json
-import sys
-from pathlib import Path
-
 from mjswarm.arena import load_arena, shipped_arenas
-from mjswarm.errors import MjswarmError
+from mjswarm.cli.output import write_json
 
 _ARENA_HELP = (
     "a shipped arena ({shipped}), a .json/.toml spec file, or a generator: "
@@ -59,9 +55,7 @@ def _register_show(actions) -> None:
 def show(args) -> int:
     """``mjswarm arena show``: print (or write as JSON) ``ArenaSpec.summary()``."""
     summary = load_arena(args.arena).summary()
-    if args.json == "-":
-        json.dump(summary, sys.stdout, indent=2)
-        print()
+    if write_json(summary, args.json):
         return 0
     rows = [
         ("name", summary["name"]),
@@ -77,11 +71,6 @@ def show(args) -> int:
         print(f"{key:<13}{value}")
     if summary["description"]:
         print(f"{'description':<13}{summary['description']}")
-    if args.json:
-        try:
-            Path(args.json).write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
-        except OSError as exc:
-            raise MjswarmError(f"cannot write {args.json}: {exc.strerror}") from None
     return 0
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import importlib
 
 #: Comparison modules (``mjswarm.cli.compare_<name>``).
-COMPARISONS: tuple[str, ...] = ("exploration",)
+COMPARISONS: tuple[str, ...] = ("exploration", "connectivity")
 
 
 def register(subparsers) -> None:

@@ -1,15 +1,14 @@
 """``mjswarm explore``: run one exploration and report seed 003's metrics.
 
-Worlds: ``graph`` (the fast abstract graph world, :mod:`mjswarm.graphworld`). Each world is
-a function ``run_<world>(args) -> dict`` registered in :data:`WORLDS`.
+Worlds: ``embodied`` (MuJoCo robots with their own sensors, :mod:`mjswarm.embodied`; the
+default) and ``graph`` (the fast abstract graph world, :mod:`mjswarm.graphworld`). Each
+world is a function ``run_<world>(args) -> dict`` registered in :data:`WORLDS`.
 """
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-
 from algorithms.exploration import STRATEGIES
+from mjswarm.cli.output import write_json
 from mjswarm.errors import MjswarmError
 from mjswarm.graphworld import EDGE_TIMES, GraphWorld
 
@@ -26,8 +25,42 @@ def run_graph(args) -> dict:
     return {"world": "graph", **result.to_dict()}
 
 
+def run_embodied(args) -> dict:
+    """One run with MuJoCo robots; the JSON-ready result (see ``EmbodiedResult``)."""
+    import sys
+
+    from mjswarm.arena import ArenaSpec, load_arena
+    from mjswarm.embodied import EmbodiedConfig, explore_embodied
+    from mjswarm.recording import Recorder
+
+    spec = load_arena(args.arena)
+    if args.root and args.root != spec.root:
+        spec = ArenaSpec(spec.name, args.root, spec.vertices, spec.edges, spec.description,
+                         spec.source)
+    order = None
+    if args.launch_order:
+        try:
+            order = [int(x) - 1 for x in args.launch_order.split(",")]
+        except ValueError:
+            raise MjswarmError(f"--launch-order takes robot numbers like 2,1,3, "
+                               f"got '{args.launch_order}'") from None
+    config = EmbodiedConfig(
+        speed_m_s=args.speed, collision_avoidance=not args.no_collision_avoidance,
+        launch_interval_s=args.launch_interval, launch_order=order,
+        max_sim_time_s=args.max_time or EmbodiedConfig.max_sim_time_s)
+    progress = sys.stderr.isatty()
+    if args.record:
+        with Recorder(args.record, spec, args.robots) as recorder:
+            result = explore_embodied(spec, args.robots, args.strategy, config, args.seed,
+                                      recorder, progress)
+    else:
+        result = explore_embodied(spec, args.robots, args.strategy, config, args.seed,
+                                  progress=progress)
+    return {"world": "embodied", **result.to_dict(), "recording": args.record}
+
+
 #: World name -> runner.
-WORLDS = {"graph": run_graph}
+WORLDS = {"embodied": run_embodied, "graph": run_graph}
 
 
 def register(subparsers) -> None:
@@ -38,12 +71,14 @@ def register(subparsers) -> None:
             "Explore an arena from its root with K robots running one strategy and report "
             "seed 003's metrics: makespan (time steps until a robot declares completion; "
             "with unit edge time, the paper's number of edge traversals), total and "
-            "per-robot traversals, who declared where, and the declaring robot's map. "
+            "per-robot traversals, who declared where, and the declaring robot's map; "
+            "embodied runs add collisions, speed changes and simulated/wall time. "
             "Exit status 1 if no robot declared completion before --max-time."
         ),
     )
-    parser.add_argument("--world", default="graph", metavar="WORLD",
-                        help=f"simulation world: {', '.join(WORLDS)} (default: graph)")
+    parser.add_argument("--world", default="embodied", metavar="WORLD",
+                        help=f"simulation world: {', '.join(WORLDS)} (default: embodied, "
+                             "MuJoCo robots; graph: the abstract graph world, no physics)")
     parser.add_argument("--arena", required=True, metavar="ARENA",
                         help="shipped arena name (e.g. fig9, tree1, arena2), path to a "
                              ".json/.toml spec, or generator (lattice:RxC, "
@@ -58,11 +93,29 @@ def register(subparsers) -> None:
     parser.add_argument("--seed", type=int, default=None, metavar="S",
                         help="randomise tie-breaking with this seed (default: the "
                              "strategies' fixed tie rules)")
-    parser.add_argument("--edge-time", default="unit", choices=EDGE_TIMES,
-                        help="time to traverse an edge: 'unit' (1 step each, as in the "
-                             "paper) or 'length' (length / mean edge length) (default: unit)")
     parser.add_argument("--max-time", type=float, default=None, metavar="T",
-                        help="give up after T time units (default: 50 (E + 1) + 100)")
+                        help="give up after T: graph world time units (default: "
+                             "50 (E + 1) + 100); embodied simulated seconds (default: 3600)")
+    graph = parser.add_argument_group("graph world")
+    graph.add_argument("--edge-time", default="unit", choices=EDGE_TIMES,
+                       help="time to traverse an edge: 'unit' (1 step each, as in the "
+                            "paper) or 'length' (length / mean edge length) (default: unit)")
+    embodied = parser.add_argument_group("embodied world")
+    embodied.add_argument("--speed", type=float, default=0.05, metavar="M_S",
+                          help="initial speed S of every robot, m/s (default: 0.05, the "
+                               "paper's experiments; top speed 0.20)")
+    embodied.add_argument("--no-collision-avoidance", action="store_true",
+                          help="turn off the bearing-rate speed rule and the vertex-entry "
+                               "check, for comparison")
+    embodied.add_argument("--launch-interval", type=float, default=2.0, metavar="S",
+                          help="least time between two robots leaving the root, seconds "
+                               "(default: 2)")
+    embodied.add_argument("--launch-order", default=None, metavar="I,J,...",
+                          help="order in which robots R1..RK are put on the root, e.g. "
+                               "3,1,2 (default: 1,2,...)")
+    embodied.add_argument("--record", default=None, metavar="FILE.rrd",
+                          help="write a rerun recording of the run (open it with "
+                               "`mjswarm view FILE.rrd`)")
     parser.add_argument("--json", default=None, metavar="PATH|-",
                         help="write the result as JSON to PATH, or to stdout with '-'")
     parser.set_defaults(func=run)
@@ -72,15 +125,8 @@ def run(args) -> int:
     if args.world not in WORLDS:
         raise MjswarmError(f"unknown world '{args.world}' (choose from {', '.join(WORLDS)})")
     result = WORLDS[args.world](args)
-    text = json.dumps(result, indent=2)
-    if args.json == "-":
-        print(text)
+    if write_json(result, args.json):
         return 0 if result["completed"] else 1
-    if args.json:
-        try:
-            Path(args.json).write_text(text + "\n")
-        except OSError as exc:
-            raise MjswarmError(f"cannot write {args.json}: {exc.strerror}") from None
     print(summary(result))
     return 0 if result["completed"] else 1
 
@@ -93,10 +139,21 @@ def summary(result: dict) -> str:
         return f"{head}\nnot completed: no robot declared completion in time"
     per_robot = " ".join(f"R{i + 1}={n}" for i, n in enumerate(result["traversals_per_robot"]))
     verdict = "equal to" if result["map_correct"] else "DIFFERENT from"
-    return "\n".join([
+    unit = "edges by one robot" if result["world"] == "embodied" else "steps"
+    lines = [
         head,
         f"completed: R{result['declared_by']} declared at {result['declared_at']} after "
-        + f"{result['makespan']} steps",
+        + f"{result['makespan']} {unit}",
         f"traversals: {result['total_traversals']} in total ({per_robot})",
         f"map: {len(result['map_edges'])} edges, {verdict} the arena's",
-    ])
+    ]
+    if result["world"] == "embodied":
+        lines += [
+            (f"physics: {result['sim_time_s']:.1f} s simulated in {result['wall_time_s']:.1f} s "
+            f"({result['realtime_factor']:.1f}x real time)"),
+            (f"collisions: {result['collisions']} robot-robot contact events; "
+            f"speed changes (eq. 27): {result['speed_changes']}"),
+        ]
+        if result["recording"]:
+            lines.append(f"recording: {result['recording']}")
+    return "\n".join(lines)

@@ -1,0 +1,73 @@
+"""``mjswarm compare connectivity``: messages against team size for the three methods."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import asdict
+
+from tqdm import tqdm
+
+from mjswarm.cli.output import write_json
+from mjswarm.connectivity.comparison import (
+    FAMILIES,
+    compare_messages,
+    markdown_table,
+    write_outputs,
+)
+from mjswarm.errors import MjswarmError
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "connectivity",
+        help="messages vs team size: stamps (seed 002) against tables (seed 004)",
+        description=(
+            "Count the messages each connectivity method needs to reach its verdict for "
+            "team sizes n_min..n_max on random geometric teams, sparse ring teams and "
+            "complete graphs (the stamps worst case), check the verdicts against networkx, "
+            "and write "
+            "messages.csv, messages.md and messages.png."
+        ),
+    )
+    parser.add_argument("--out", default="out/compare_connectivity", metavar="DIR",
+                        help="output directory (default out/compare_connectivity)")
+    parser.add_argument("--n-min", type=int, default=3, help="smallest team (default 3)")
+    parser.add_argument("--n-max", type=int, default=30, help="largest team (default 30)")
+    parser.add_argument("--n-step", type=int, default=3, help="team size step (default 3)")
+    parser.add_argument("--samples", type=int, default=5,
+                        help="random teams per size and family (default 5)")
+    parser.add_argument("--mean-degree", type=float, default=4.0,
+                        help="target mean number of radio neighbours (default 4)")
+    parser.add_argument("--seed", type=int, default=0, help="seed for the teams (default 0)")
+    parser.add_argument("--message-cap", type=int, default=100_000, metavar="M",
+                        help="stop a run after M messages, counted as capped (default 100000)")
+    parser.add_argument("--json", metavar="PATH",
+                        help="also write the rows as JSON to PATH ('-' for stdout only)")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.n_step < 1 or args.n_min > args.n_max:
+        raise MjswarmError("need --n-step >= 1 and --n-min <= --n-max")
+    if args.message_cap < 1:
+        raise MjswarmError(f"message cap must be at least 1, got {args.message_cap}")
+    ns = list(range(args.n_min, args.n_max + 1, args.n_step))
+    total = len(ns) * (args.samples * (len(FAMILIES) - 1) + 1)
+    with tqdm(total=total, desc="teams", unit="team", file=sys.stderr,
+              disable=not sys.stderr.isatty()) as bar:
+        rows = compare_messages(
+            ns,
+            samples=args.samples,
+            mean_degree=args.mean_degree,
+            seed=args.seed,
+            message_cap=args.message_cap,
+            progress=bar.update,
+        )
+    paths = write_outputs(rows, args.out)
+    records = [asdict(r) for r in rows]
+    if write_json(records, args.json):
+        return 0
+    print(markdown_table(rows))
+    print("wrote " + ", ".join(str(p) for p in paths))
+    return 0

@@ -1,0 +1,151 @@
+"""Static message-passing harness: run a connectivity method on a team to its decision.
+
+Each tick the radio delivers last tick's messages, then every robot (in team order) reads
+its inbox, sees its neighbours and answers with messages to send; one tick is the papers'
+c. The harness counts messages from the radio's counters and stops at the deciding robot's
+decision: the initiator (``stamps``, seed 002 Algorithm 3: tick 6N + 2 at the latest) or
+the reference (``tables`` / ``tables-2``, seed 004 with the gathering of
+:class:`algorithms.connectivity.TableCheck`: tick 2N - 1).
+
+The stamps method floods every simple path, so its cost is factorial on dense graphs.
+The harness stops any method once more than ``message_cap`` messages have been sent; the
+result then has ``capped = True`` and unknown (None) verdicts, and ``messages`` /
+``rounds`` say how far it got.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Hashable, Mapping
+from dataclasses import asdict, dataclass
+
+from algorithms.connectivity import BiconnectivityCheck, TableCheck
+from mjswarm.connectivity.team import Team
+from mjswarm.errors import MjswarmError
+from mjswarm.radio import Radio
+
+#: Method names: seed 002's stamps, seed 004's tables and its forward-two variant.
+METHODS: tuple[str, ...] = ("stamps", "tables", "tables-2")
+#: Default limit on messages (transmissions) before a run is stopped as capped.
+DEFAULT_MESSAGE_CAP = 200_000
+
+
+@dataclass(frozen=True)
+class CheckResult:
+    """Outcome of one check. Verdicts are None when unknown (capped run).
+
+    ``articulation_points`` (sorted ids) is None for ``stamps``, which does not find them;
+    for the tables methods it covers the reference's component. ``messages`` counts
+    transmissions (a broadcast is one), ``deliveries`` the copies received; ``rounds`` is
+    the tick of the decision (c = 1 tick).
+    """
+
+    method: str
+    robots: int
+    initiator: str
+    connected: bool | None
+    biconnected: bool | None
+    articulation_points: list[str] | None
+    messages: int
+    max_messages_per_robot: int
+    deliveries: int
+    rounds: int
+    capped: bool
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def drive(
+    radio: Radio,
+    robots: Mapping[Hashable, object],
+    until: Callable[[], bool],
+    *,
+    start: int = 0,
+    max_ticks: int = 10_000,
+    message_cap: int | None = None,
+) -> tuple[int, bool]:
+    """Run ticks ``start, start + 1, ...`` until ``until()`` holds after a tick.
+
+    ``robots`` maps radio ids to objects with ``tick(now, inbox, neighbors)``. Returns
+    ``(last tick, capped)``; capped means more than ``message_cap`` messages were sent
+    (checked after each robot's turn, so a dense flood cannot run away within a tick).
+    """
+    for now in range(start, start + max_ticks):
+        radio.step()
+        for rid, robot in robots.items():
+            for message in robot.tick(now, radio.receive(rid), radio.neighbors(rid)):
+                radio.send(rid, message.payload, message.to)
+            if message_cap is not None and radio.total_sent > message_cap:
+                return now, True
+        if until():
+            return now, False
+    raise RuntimeError(f"no decision within {max_ticks} ticks")
+
+
+def run_check(
+    team: Team,
+    method: str,
+    *,
+    range_m: float | None = None,
+    initiator: str | None = None,
+    max_robots: int | None = None,
+    drop_prob: float = 0.0,
+    seed: int | None = 0,
+    message_cap: int | None = DEFAULT_MESSAGE_CAP,
+) -> CheckResult:
+    """Run ``method`` on ``team`` and report verdicts and message counts.
+
+    Args:
+        team: positions (metres) and optional explicit edges / walls.
+        method: one of :data:`METHODS`.
+        range_m: radio range d_c in metres (required unless the team has explicit edges).
+        initiator: the robot that starts the check (stamps) or is the reference (tables);
+            default the team's first robot.
+        max_robots: N of seed 002 Assumption 1 (default n); sets the timing.
+        drop_prob, seed: radio message loss (the papers assume none).
+        message_cap: stop once more messages than this were sent (None: no cap).
+    """
+    if method not in METHODS:
+        raise MjswarmError(f"unknown method {method!r} (choose from {', '.join(METHODS)})")
+    ids = team.ids
+    n = len(ids)
+    leader = ids[0] if initiator is None else initiator
+    if leader not in team.positions:
+        raise MjswarmError(f"initiator {leader!r} is not a robot of {team.source}")
+    if max_robots is not None and max_robots < n:
+        raise MjswarmError(f"N (max robots) = {max_robots} is below the team size {n}")
+    if message_cap is not None and message_cap < 1:
+        raise MjswarmError(f"message cap must be at least 1, got {message_cap}")
+    radio = team.radio(range_m, drop_prob=drop_prob, rng=seed)
+    if method == "stamps":
+        nodes = {
+            r: BiconnectivityCheck(r, n, max_robots=max_robots, initiator=r == leader)
+            for r in ids
+        }
+    else:
+        forwards = 2 if method == "tables-2" else None
+        nodes = {
+            r: TableCheck(r, leader, n, max_robots=max_robots, max_forwards=forwards)
+            for r in ids
+        }
+    decider = nodes[leader]
+    rounds, capped = drive(
+        radio,
+        nodes,
+        lambda: decider.connected is not None,
+        message_cap=message_cap,
+    )
+    points = getattr(decider, "articulation_points", None)
+    return CheckResult(
+        method=method,
+        robots=n,
+        initiator=leader,
+        connected=None if capped else decider.connected,
+        biconnected=None if capped else decider.biconnected,
+        articulation_points=None if capped or points is None else sorted(points),
+        messages=radio.total_sent,
+        max_messages_per_robot=max(radio.sent.values()),
+        deliveries=sum(radio.received.values()),
+        rounds=rounds,
+        capped=capped,
+    )

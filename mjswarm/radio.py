@@ -1,0 +1,279 @@
+"""The robots' radio: one-hop broadcast within range d_c, delivered one control tick later.
+
+This is the communication model both connectivity papers assume (seed 002, Assumptions 2
+and 4; seed 004, section 2): identical ranges (so links are symmetric), a message sent by a
+robot is heard by every robot within range d_c of it, and it arrives within one period c,
+which here is exactly one control tick. On top of that the radio can drop each copy of a
+message with probability ``drop_prob`` (seeded numpy Generator) and can block a link when
+line of sight is lost (an injected ``blocked(i, j) -> bool``: the embodied world passes an
+``mj_ray``-based one, the static harness :func:`walls_blocker`). Per-robot counters give the
+papers' message complexities.
+
+One control tick, as the world or the harness drives it::
+
+    radio.step(positions)              # deliver last tick's messages, links from positions
+    for robot in robots:
+        inbox = radio.receive(robot)   # what arrived this tick
+        ...                            # the controller decides
+        radio.send(robot, payload)     # heard by robot's neighbours at the next step()
+
+Choices the papers leave open:
+
+* The recipients of a message are fixed when it is sent (the robots within range at the
+  last :meth:`Radio.step`); it is delivered at the next ``step`` unless that copy is
+  dropped or the recipient has left (:meth:`Radio.remove`).
+* A link exists iff the distance is at most d_c (inclusive) and ``blocked`` says it is not
+  blocked. Distances are Euclidean over whatever coordinates the positions have (metres).
+* ``send(..., to=j)`` is a broadcast that only robot ``j`` keeps (the papers' table
+  exchange and reports): it costs one transmission and reaches ``j`` only if ``j`` is a
+  neighbour. Counters count transmissions sent and copies received.
+* Drops are decided copy by copy at delivery, in send order and, within a message, in
+  robot order, so a run is a pure function of the seed.
+* Explicit-edge mode (``edges=...``) replaces the range by a given link set, for the static
+  harness and tests; :meth:`Radio.set_edges` changes it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
+from typing import Any, NamedTuple
+
+import networkx as nx
+import numpy as np
+
+from mjswarm.errors import MjswarmError
+
+#: ``blocked(i, j) -> True`` when robots i and j cannot hear each other (no line of sight).
+Blocker = Callable[[Hashable, Hashable], bool]
+
+
+class Message(NamedTuple):
+    """One received copy: who sent it and what it carries (opaque to the radio)."""
+
+    sender: Hashable
+    payload: Any
+
+
+class Radio:
+    """Broadcast radio with range d_c (or explicit links), one-tick latency, drops, counters.
+
+    Args:
+        robots: robot ids, in the order used for deterministic delivery.
+        range_m: communication range d_c in metres (range mode).
+        edges: explicit links ``(i, j)`` instead of a range (explicit-edge mode).
+        blocked: optional line-of-sight test ``blocked(i, j)``, asked for in-range pairs.
+        drop_prob: probability in [0, 1) that one copy of a message is lost.
+        rng: numpy Generator or seed for the drops.
+
+    Exactly one of ``range_m`` and ``edges`` must be given.
+    """
+
+    def __init__(
+        self,
+        robots: Iterable[Hashable],
+        *,
+        range_m: float | None = None,
+        edges: Iterable[tuple[Hashable, Hashable]] | None = None,
+        blocked: Blocker | None = None,
+        drop_prob: float = 0.0,
+        rng: np.random.Generator | int | None = None,
+    ) -> None:
+        self.robots: tuple[Hashable, ...] = tuple(robots)
+        if len(set(self.robots)) != len(self.robots):
+            raise MjswarmError("radio: duplicate robot ids")
+        if (range_m is None) == (edges is None):
+            raise MjswarmError("radio: give exactly one of a range (metres) or explicit edges")
+        if range_m is not None and not (math.isfinite(range_m) and range_m > 0):
+            raise MjswarmError(f"radio: range must be a positive number of metres, got {range_m}")
+        if not 0.0 <= drop_prob < 1.0:
+            raise MjswarmError(f"radio: drop probability must be in [0, 1), got {drop_prob}")
+        self.range_m = range_m
+        self.blocked = blocked
+        self.drop_prob = float(drop_prob)
+        self._rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+        self._present: dict[Hashable, None] = dict.fromkeys(self.robots)
+        self._neighbors: dict[Hashable, frozenset] = {r: frozenset() for r in self.robots}
+        self._ordered: dict[Hashable, tuple] = {r: () for r in self.robots}
+        self._edges: frozenset[frozenset] | None = None
+        self._positions: dict[Hashable, np.ndarray] = {}
+        self._outbox: list[tuple[Hashable, Any, tuple[Hashable, ...]]] = []
+        self._inbox: dict[Hashable, list[Message]] = {r: [] for r in self.robots}
+        #: transmissions per robot (one per :meth:`send`)
+        self.sent: dict[Hashable, int] = dict.fromkeys(self.robots, 0)
+        #: copies received per robot
+        self.received: dict[Hashable, int] = dict.fromkeys(self.robots, 0)
+        #: copies lost to ``drop_prob``
+        self.dropped = 0
+        #: number of :meth:`step` calls so far
+        self.tick = 0
+        if edges is not None:
+            self.set_edges(edges)
+
+    # -- topology ---------------------------------------------------------------------
+    def set_edges(self, edges: Iterable[tuple[Hashable, Hashable]]) -> None:
+        """Explicit-edge mode: replace the link set (takes effect immediately)."""
+        if self.range_m is not None:
+            raise MjswarmError("radio: set_edges needs a radio built with explicit edges")
+        links = set()
+        for i, j in edges:
+            if i not in self._inbox or j not in self._inbox:
+                raise MjswarmError(f"radio: edge ({i}, {j}) names an unknown robot")
+            if i != j:
+                links.add(frozenset((i, j)))
+        self._edges = frozenset(links)
+        self._relink()
+
+    def remove(self, robot: Hashable) -> None:
+        """The robot leaves (crash or recall): no links, nothing more sent to or by it."""
+        self._present.pop(robot, None)
+        self._outbox = [m for m in self._outbox if m[0] != robot]
+        self._inbox[robot].clear()
+        self._relink()
+
+    def neighbors(self, robot: Hashable) -> frozenset:
+        """Robots that hear ``robot`` this tick (link-layer knowledge, no message cost)."""
+        return self._neighbors[robot]
+
+    def graph(self) -> nx.Graph:
+        """The current radio graph of present robots (node attribute ``pos`` if known)."""
+        g = nx.Graph()
+        for r in self._present:
+            g.add_node(r, **({"pos": tuple(self._positions[r])} if r in self._positions else {}))
+        g.add_edges_from((i, j) for i in self._present for j in self._neighbors[i])
+        return g
+
+    @property
+    def present(self) -> tuple[Hashable, ...]:
+        """Robots still in the team, in the radio's order."""
+        return tuple(self._present)
+
+    # -- one control tick -------------------------------------------------------------
+    def step(self, positions: Mapping[Hashable, Sequence[float]] | None = None) -> None:
+        """Advance one control tick: deliver last tick's messages, then update the links.
+
+        ``positions`` (metres) must cover every present robot in range mode; ``None`` keeps
+        the previous positions (static harness) and is the only choice in explicit mode.
+        """
+        self.tick += 1
+        self._deliver()
+        if positions is not None:
+            self.move(positions)
+        elif self.range_m is not None and not self._positions:
+            raise MjswarmError("radio: range mode needs positions at the first step")
+
+    def move(self, positions: Mapping[Hashable, Sequence[float]]) -> None:
+        """Range mode: set the robots' positions (metres) and recompute the links now."""
+        if self.range_m is None:
+            raise MjswarmError("radio: explicit-edge mode takes no positions")
+        missing = [r for r in self._present if r not in positions]
+        if missing:
+            raise MjswarmError(f"radio: no position for robot {missing[0]!r}")
+        self._positions = {r: np.asarray(positions[r], dtype=float) for r in self._present}
+        self._relink()
+
+    def send(self, sender: Hashable, payload: Any, to: Hashable | None = None) -> None:
+        """Transmit ``payload`` to the sender's current neighbours (or only ``to``)."""
+        if sender not in self._present:
+            raise MjswarmError(f"radio: robot {sender!r} is not in the team")
+        self.sent[sender] += 1
+        if to is None:
+            recipients = self._ordered[sender]
+        else:
+            recipients = (to,) if to in self._neighbors[sender] else ()
+        self._outbox.append((sender, payload, recipients))
+
+    def receive(self, robot: Hashable) -> list[Message]:
+        """Drain and return what ``robot`` has received (in delivery order)."""
+        inbox, self._inbox[robot] = self._inbox[robot], []
+        return inbox
+
+    @property
+    def pending(self) -> int:
+        """Transmissions sent this tick and not yet delivered."""
+        return len(self._outbox)
+
+    @property
+    def total_sent(self) -> int:
+        """All transmissions so far (the papers' message count)."""
+        return sum(self.sent.values())
+
+    # -- internals ----------------------------------------------------------------------
+    def _deliver(self) -> None:
+        outbox, self._outbox = self._outbox, []
+        for sender, payload, recipients in outbox:
+            message = Message(sender, payload)
+            for r in recipients:
+                if r not in self._present:
+                    continue
+                if self.drop_prob and self._rng.random() < self.drop_prob:
+                    self.dropped += 1
+                    continue
+                self._inbox[r].append(message)
+                self.received[r] += 1
+
+    def _relink(self) -> None:
+        present = list(self._present)
+        pairs: Iterable[tuple[Hashable, Hashable]]
+        if self.range_m is None:
+            pairs = [tuple(e) for e in self._edges or () if all(r in self._present for r in e)]
+        elif not self._positions:
+            pairs = []
+        else:
+            xy = np.stack([self._positions[r] for r in present])
+            d2 = ((xy[:, None, :] - xy[None, :, :]) ** 2).sum(axis=-1)
+            ii, jj = np.nonzero(np.triu(d2 <= self.range_m**2, k=1))
+            pairs = [(present[i], present[j]) for i, j in zip(ii.tolist(), jj.tolist())]
+            if self.blocked is not None:
+                pairs = [(i, j) for i, j in pairs if not self.blocked(i, j)]
+        neighbors: dict[Hashable, set] = {r: set() for r in self.robots}
+        for i, j in pairs:
+            neighbors[i].add(j)
+            neighbors[j].add(i)
+        self._neighbors = {r: frozenset(s) for r, s in neighbors.items()}
+        self._ordered = {r: tuple(x for x in self.robots if x in s) for r, s in neighbors.items()}
+
+
+def walls_blocker(
+    walls: Iterable[tuple[Sequence[float], Sequence[float]]],
+    positions: Mapping[Hashable, Sequence[float]],
+) -> Blocker:
+    """Line of sight for the static harness: 2-D wall segments block a link.
+
+    Returns ``blocked(i, j)``, true when the segment between the positions of robots i and j
+    (read from ``positions`` at call time, metres, x and y) meets any wall segment, touching
+    included. The embodied world uses an ``mj_ray``-based test instead.
+    """
+    w = np.asarray([(a[0], a[1], b[0], b[1]) for a, b in walls], dtype=float).reshape(-1, 4)
+    c, d = w[:, 0:2], w[:, 2:4]
+
+    def cross(o: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
+        return (p[..., 0] - o[..., 0]) * (q[..., 1] - o[..., 1]) - (p[..., 1] - o[..., 1]) * (
+            q[..., 0] - o[..., 0]
+        )
+
+    def on_segment(o: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
+        # q collinear with o-p: is it within the bounding box of o-p?
+        return (np.minimum(o[..., 0], p[..., 0]) <= q[..., 0]) & (
+            q[..., 0] <= np.maximum(o[..., 0], p[..., 0])
+        ) & (np.minimum(o[..., 1], p[..., 1]) <= q[..., 1]) & (
+            q[..., 1] <= np.maximum(o[..., 1], p[..., 1])
+        )
+
+    def blocked(i: Hashable, j: Hashable) -> bool:
+        if not len(w):
+            return False
+        a = np.broadcast_to(np.asarray(positions[i], dtype=float)[:2], c.shape)
+        b = np.broadcast_to(np.asarray(positions[j], dtype=float)[:2], c.shape)
+        d1, d2 = cross(c, d, a), cross(c, d, b)
+        d3, d4 = cross(a, b, c), cross(a, b, d)
+        proper = (d1 * d2 < 0) & (d3 * d4 < 0)
+        touch = (
+            ((d1 == 0) & on_segment(c, d, a))
+            | ((d2 == 0) & on_segment(c, d, b))
+            | ((d3 == 0) & on_segment(a, b, c))
+            | ((d4 == 0) & on_segment(a, b, d))
+        )
+        return bool(np.any(proper | touch))
+
+    return blocked
