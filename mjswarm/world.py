@@ -81,10 +81,12 @@ def world_spec(
     robot_xml: str = str(DEFAULT_ROBOT_XML),
     timestep_s: float = PHYSICS_TIMESTEP_S,
     margin_m: float = 1.0,
+    floor_points: Sequence[tuple[float, float]] = (),
 ) -> mujoco.MjSpec:
     """An uncompiled world: floor, strips, walls and one robot per pose (``r0`` ...).
 
-    The floor is a plane covering every robot, strip and wall plus ``margin_m``.
+    The floor is a plane covering every robot, strip, wall and ``floor_points`` (m) plus
+    ``margin_m``.
     Callers may add more elements (vertex sites, say) before compiling.
     """
     if timestep_s <= 0.0:
@@ -99,7 +101,7 @@ def world_spec(
     spec.visual.global_.offwidth = 1280
     spec.visual.global_.offheight = 960
 
-    points = [(p.x, p.y) for p in poses]
+    points = [(p.x, p.y) for p in poses] + [tuple(p) for p in floor_points]
     points += [pt for s in strips for pt in (s.start, s.end)]
     points += [pt for w in walls for pt in (w.start, w.end)]
     xy = np.array(points, float).reshape(-1, 2) if points else np.zeros((1, 2))

@@ -1,0 +1,165 @@
+"""Open-floor worlds for the connectivity-maintenance experiments (seeds 001 and 002).
+
+Two worlds with one interface, :class:`MotionWorld`, so the same algorithm code runs on
+MuJoCo robots (:class:`EmbodiedFloor`) and on kinematic points (:class:`PointWorld`):
+
+* robots take **planar velocity commands** (m/s, world frame) and follow them with the
+  unicycle tracker of :mod:`algorithms.motion` within the Spark V's limits
+  (0.2 m/s, ``omega_max``);
+* robots **sense their own position and heading** through a positioning sensor (the
+  papers assume robots know their positions; think UWB or motion capture) with optional
+  Gaussian noise; controllers use :meth:`MotionWorld.sense` only;
+* robots can be **added and removed** (seed 002's episodes): an absent robot waits in a
+  depot outside the floor (embodied) and is invisible to the radio and the sensors.
+
+Ground truth (:meth:`MotionWorld.true_positions`) is for metrics, the radio and tests.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
+
+import numpy as np
+
+from algorithms.motion import track_velocity
+from mjswarm.errors import MjswarmError
+
+#: Spark V top speed (m/s) and the turn rate we allow the tracker (rad/s).
+V_MAX_M_S = 0.2
+OMEGA_MAX_RAD_S = 2.0
+
+
+class MotionWorld(ABC):
+    """N robots on an open floor, driven by planar velocity commands.
+
+    Args:
+        positions: start positions (m), one per robot; ``present`` says which are on the
+            floor (the rest wait in the depot).
+        seed: seeds the position-sensor noise.
+        position_noise_m, heading_noise_rad: standard deviations of the positioning sensor.
+    """
+
+    def __init__(self, positions: Sequence[tuple[float, float]], present: Sequence[bool] | None,
+                 seed: int, position_noise_m: float, heading_noise_rad: float) -> None:
+        if len(positions) < 1:
+            raise MjswarmError("an open-floor world needs at least one robot")
+        if position_noise_m < 0 or heading_noise_rad < 0:
+            raise MjswarmError("sensor noise standard deviations must be >= 0")
+        self.n = len(positions)
+        self.present = np.ones(self.n, bool) if present is None else np.array(present, bool)
+        self.rng = np.random.default_rng(seed)
+        self.position_noise_m, self.heading_noise_rad = position_noise_m, heading_noise_rad
+        self.time_s = 0.0
+
+    @abstractmethod
+    def true_poses(self) -> np.ndarray:
+        """Ground truth, shape (N, 3): x, y (m), yaw (rad). Not for controllers."""
+
+    @abstractmethod
+    def _advance(self, v: np.ndarray, omega: np.ndarray, duration_s: float) -> None:
+        """Drive every present robot with ``(v, omega)`` for ``duration_s`` seconds."""
+
+    @abstractmethod
+    def place(self, i: int, xy: tuple[float, float] | None, yaw: float = 0.0) -> None:
+        """Put robot ``i`` on the floor at ``xy`` (m), or take it off (``None``)."""
+
+    def true_positions(self) -> np.ndarray:
+        return self.true_poses()[:, :2]
+
+    def sense(self) -> np.ndarray:
+        """Each robot's positioning-sensor reading, shape (N, 3): x, y (m), yaw (rad)."""
+        poses = self.true_poses().copy()
+        if self.position_noise_m:
+            poses[:, :2] += self.rng.normal(0.0, self.position_noise_m, (self.n, 2))
+        if self.heading_noise_rad:
+            poses[:, 2] += self.rng.normal(0.0, self.heading_noise_rad, self.n)
+        return poses
+
+    def step(self, velocities: np.ndarray, duration_s: float) -> None:
+        """Follow planar velocities (m/s, shape (N, 2)) for ``duration_s`` seconds."""
+        velocities = np.asarray(velocities, float).reshape(self.n, 2)
+        sensed = self.sense()
+        commands = [track_velocity(sensed[i, 2], velocities[i], V_MAX_M_S, OMEGA_MAX_RAD_S)
+                    if self.present[i] else (0.0, 0.0) for i in range(self.n)]
+        v, omega = (np.array(c) for c in zip(*commands))
+        self._advance(v, omega, duration_s)
+        self.time_s += duration_s
+
+
+class PointWorld(MotionWorld):
+    """Kinematic unicycles: exact integration of ``(v, omega)``, no bodies, no contacts."""
+
+    def __init__(self, positions, present=None, seed=0, position_noise_m=0.0,
+                 heading_noise_rad=0.0, dt_s: float = 0.02) -> None:
+        super().__init__(positions, present, seed, position_noise_m, heading_noise_rad)
+        self.dt_s = dt_s
+        self._poses = np.zeros((self.n, 3))
+        self._poses[:, :2] = np.asarray(positions, float)
+
+    def true_poses(self) -> np.ndarray:
+        return self._poses
+
+    def place(self, i, xy, yaw=0.0) -> None:
+        self.present[i] = xy is not None
+        if xy is not None:
+            self._poses[i] = (xy[0], xy[1], yaw)
+
+    def _advance(self, v, omega, duration_s) -> None:
+        for _ in range(max(1, round(duration_s / self.dt_s))):
+            yaw = self._poses[:, 2]
+            self._poses[:, 0] += v * np.cos(yaw) * self.dt_s
+            self._poses[:, 1] += v * np.sin(yaw) * self.dt_s
+            self._poses[:, 2] = yaw + omega * self.dt_s
+
+
+class EmbodiedFloor(MotionWorld):
+    """Spark V robots in MuJoCo on a bare floor; absent robots wait in a depot row.
+
+    ``floor_half_size_m`` sizes the floor around the origin; the depot lies beyond it.
+    Robot-robot contacts are counted in ``self.sim.collisions``.
+    """
+
+    def __init__(self, positions, present=None, seed=0, position_noise_m=0.0,
+                 heading_noise_rad=0.0, floor_half_size_m: float = 10.0) -> None:
+        from mjswarm.simulation import Simulation
+        from mjswarm.world import Pose2D, world_spec
+
+        super().__init__(positions, present, seed, position_noise_m, heading_noise_rad)
+        self._depot = [(-floor_half_size_m + 0.4 * i, -floor_half_size_m - 1.0)
+                       for i in range(self.n)]
+        poses = [Pose2D(*(positions[i] if self.present[i] else self._depot[i]), 0.0)
+                 for i in range(self.n)]
+        corners = [(-floor_half_size_m, -floor_half_size_m),
+                   (floor_half_size_m, floor_half_size_m)]
+        spec = world_spec(poses, margin_m=1.5, floor_points=corners)
+        self._pose_type = Pose2D
+        self.sim = Simulation(spec, seed=seed)
+
+    def true_poses(self) -> np.ndarray:
+        return self.sim.poses()
+
+    def place(self, i, xy, yaw=0.0) -> None:
+        self.present[i] = xy is not None
+        where = xy if xy is not None else self._depot[i]
+        self.sim.place_robot(i, self._pose_type(where[0], where[1], yaw))
+
+    def _advance(self, v, omega, duration_s) -> None:
+        self.sim.set_velocity(v, omega)
+        self.sim.step(max(1, round(duration_s / self.sim.control_dt_s)))
+
+
+def spread(n: int, radius_m: float, seed: int) -> list[tuple[float, float]]:
+    """``n`` random positions in a disc of ``radius_m`` at least 0.2 m apart (a helper for
+    tests and experiments; raises :class:`MjswarmError` if they do not fit)."""
+    rng = np.random.default_rng(seed)
+    points: list[tuple[float, float]] = []
+    for _ in range(1000 * n):
+        if len(points) == n:
+            return points
+        r, a = radius_m * math.sqrt(rng.uniform()), rng.uniform(0, 2 * math.pi)
+        p = (r * math.cos(a), r * math.sin(a))
+        if all(math.dist(p, q) >= 0.2 for q in points):
+            points.append(p)
+    raise MjswarmError(f"cannot place {n} robots 0.2 m apart in a {radius_m} m disc")
