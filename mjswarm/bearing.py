@@ -37,8 +37,6 @@ class BearingSensor:
         self.sim = sim
         self.fov_rad, self.range_m, self.noise_rad = fov_rad, range_m, noise_rad
         self.rng = np.random.default_rng(seed)
-        self._group = np.array([1, 0, 0, 0, 0, 0], dtype=np.uint8)
-        self._geomid = np.zeros(1, dtype=np.int32)
 
     def read(self, poses: np.ndarray | None = None) -> list[dict[int, float]]:
         """For every robot ``k``: ``{p: beta_kp}`` (rad) of the robots it sees now."""
@@ -53,16 +51,21 @@ class BearingSensor:
         np.fill_diagonal(candidates, False)
         out: list[dict[int, float]] = [{} for _ in range(n)]
         for k, p in zip(*np.nonzero(candidates)):
-            if self._line_of_sight(k, p, poses):
+            if line_of_sight(sim, k, p, poses):
                 noise = self.rng.normal(0.0, self.noise_rad) if self.noise_rad else 0.0
                 out[k][int(p)] = float(beta[k, p] + noise)
         return out
 
-    def _line_of_sight(self, k: int, p: int, poses: np.ndarray) -> bool:
-        sim = self.sim
-        start = np.array([poses[k, 0], poses[k, 1], RAY_HEIGHT_M])
-        vec = np.array([poses[p, 0] - poses[k, 0], poses[p, 1] - poses[k, 1], 0.0])
-        mujoco.mj_ray(sim.model, sim.data, start, vec, self._group, 1,
-                      int(sim.robot_bodies[k]), self._geomid)
-        hit = self._geomid[0]
-        return hit >= 0 and sim.geom_robot[hit] == p
+
+_GROUP0 = np.array([1, 0, 0, 0, 0, 0], dtype=np.uint8)
+
+
+def line_of_sight(sim: Simulation, k: int, p: int, poses: np.ndarray | None = None) -> bool:
+    """Whether robot ``p`` is the first thing a ray from robot ``k``'s centre towards it
+    hits (collision geoms only, at RAY_HEIGHT_M): walls and other robots block."""
+    poses = sim.poses() if poses is None else poses
+    start = np.array([poses[k, 0], poses[k, 1], RAY_HEIGHT_M])
+    vec = np.array([poses[p, 0] - poses[k, 0], poses[p, 1] - poses[k, 1], 0.0])
+    geomid = np.zeros(1, dtype=np.int32)
+    mujoco.mj_ray(sim.model, sim.data, start, vec, _GROUP0, 1, int(sim.robot_bodies[k]), geomid)
+    return geomid[0] >= 0 and sim.geom_robot[geomid[0]] == p

@@ -57,6 +57,7 @@ from algorithms.exploration.base import AngleMismatch
 from algorithms.navigation import NavigatorState
 from mjswarm.arena import ArenaSpec
 from mjswarm.arena.builder import arena_world_spec
+from mjswarm.awareness import TableAwareness
 from mjswarm.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
 from mjswarm.graphworld import ExplorationResult, make_minds
@@ -86,6 +87,8 @@ class EmbodiedConfig:
         max_sim_time_s: give up after this much simulated time.
         turn_rate_rad_s: in-place turn and scan rate.
         bearing_fov_deg, bearing_range_m, bearing_noise_deg: the bearing sensor.
+        radio_range_m: with a range (m), robots carry radios and keep connectivity tables
+            (:mod:`mjswarm.awareness`); None: no radio.
     """
 
     speed_m_s: float = 0.05
@@ -99,6 +102,7 @@ class EmbodiedConfig:
     bearing_fov_deg: float = 60.0
     bearing_range_m: float = 1.0
     bearing_noise_deg: float = 0.0
+    radio_range_m: float | None = None
 
 
 @dataclass
@@ -115,6 +119,11 @@ class EmbodiedResult(ExplorationResult):
     realtime_factor: float = 0.0
     #: robots that stopped: lost their line, or their angles no longer match the beacons
     lost_robots: list[int] = field(default_factory=list)
+    #: with a radio: messages sent in all, by the busiest robot, and the share of sampled
+    #: robot beliefs ("biconnected" or not) that equalled the truth
+    radio_messages: int | None = None
+    radio_max_messages_per_robot: int | None = None
+    radio_belief_agreement: float | None = None
 
 
 class EmbodiedExploration:
@@ -164,6 +173,11 @@ class EmbodiedExploration:
         self.last_launch = -math.inf
         self.declared: tuple[float, int, str] | None = None
         self.confused: list[int] = []  # robots whose angles stopped matching the beacons
+        self.awareness = None
+        if config.radio_range_m is not None:
+            if config.radio_range_m <= 0:
+                raise MjswarmError(f"radio range must be positive, got {config.radio_range_m} m")
+            self.awareness = TableAwareness(self.sim, config.radio_range_m)
         self._vertices = np.array(list(spec.vertices.values()))
         self._vertex_ids = list(spec.vertices)
 
@@ -214,6 +228,8 @@ class EmbodiedExploration:
             v[i], w[i], speeds[i] = vi, wi, speed
         sim.set_velocity(v, w)
         sim.step()
+        if self.awareness is not None:
+            self._radio_tick()
         if self.recorder is not None:
             self.recorder.log_tick(sim.step_count, sim.time_s, sim.poses(),
                                    sim.readings()["line"], sim.readings()["ir"], speeds,
@@ -221,6 +237,17 @@ class EmbodiedExploration:
                                    [[] for _ in range(sim.n)])
 
     # ------------------------------------------------------------------ robots
+    def _radio_tick(self) -> None:
+        """Tables follow the moving radio graph; beliefs sampled 5 times a second."""
+        aware = self.awareness
+        aware.step(np.array(self.active))
+        if self.sim.step_count % 10:
+            return
+        beliefs, truth = aware.sample()
+        if self.recorder is not None:
+            edges = [tuple(e) for e in aware.radio.graph().edges]
+            self.recorder.log_radio(self.sim.step_count, self.sim.time_s, edges, beliefs, truth)
+
     def _launch_if_free(self) -> None:
         if not self.launch_queue:
             return
@@ -385,6 +412,10 @@ class EmbodiedExploration:
             sim_time_s=sim_time,
             wall_time_s=wall,
             realtime_factor=sim_time / wall if wall > 0 else math.inf,
+            radio_messages=None if self.awareness is None else self.awareness.radio.total_sent,
+            radio_max_messages_per_robot=(None if self.awareness is None
+                                          else max(self.awareness.radio.sent.values())),
+            radio_belief_agreement=None if self.awareness is None else self.awareness.agreement,
             lost_robots=sorted(self.confused + [
                 i for i, nav in enumerate(self.driver.navigators)
                 if nav.state is NavigatorState.LOST]),

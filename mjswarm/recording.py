@@ -437,13 +437,14 @@ class Recorder:
         sim_time_s: float,
         edges: Sequence[tuple[int, int]],
         beliefs: Mapping[int, str] | None = None,
-        truth: str | None = None,
+        truth: str | Mapping[int, str] | None = None,
     ) -> None:
         """The radio graph (robot index pairs in range), drawn at the robots' positions.
 
         With ``beliefs`` (robot -> its current answer, e.g. whether the team is
-        biconnected) and ``truth`` (the ground-truth answer), nodes are green where the
-        belief equals the truth, red where it differs, grey without a belief.
+        biconnected) and ``truth`` (the ground-truth answer: one for the team, or one per
+        robot), nodes are green where the belief equals the truth, red where it differs,
+        grey without a belief.
         """
         self._at(step, sim_time_s)
         n = self.n_robots
@@ -453,11 +454,13 @@ class Recorder:
         beliefs = dict(beliefs or {})
         ids = [f"r{i}" for i in range(n)]
         labels = [f"r{i}: {beliefs[i]}" if i in beliefs else f"r{i}" for i in range(n)]
-        if truth is None:
+        truths = (None if truth is None else
+                  dict(truth) if isinstance(truth, Mapping) else dict.fromkeys(range(n), truth))
+        if truths is None:
             colors = [robot_color(i) for i in range(n)]
         else:
             colors = [_NO_BELIEF_COLOR if i not in beliefs
-                      else _AGREE_COLOR if beliefs[i] == truth else _DISAGREE_COLOR
+                      else _AGREE_COLOR if beliefs[i] == truths.get(i) else _DISAGREE_COLOR
                       for i in range(n)]
         xy = self._positions()
         self._stream.log("radio/graph",
@@ -471,8 +474,12 @@ class Recorder:
                 [[(*xy[a], z), (*xy[b], z)] for a, b in edges],
                 colors=(60, 140, 255, 200), radii=0.003))
         if truth is not None or beliefs:
-            lines = [] if truth is None else [f"truth: {truth}"]
-            lines += [f"r{i}: {beliefs[i]}" for i in sorted(beliefs)]
+            if isinstance(truth, Mapping):
+                lines = [f"r{i}: {beliefs.get(i, '-')} (truth: {truth.get(i, '-')})"
+                         for i in range(n)]
+            else:
+                lines = [] if truth is None else [f"truth: {truth}"]
+                lines += [f"r{i}: {beliefs[i]}" for i in sorted(beliefs)]
             self._stream.log("radio/truth", rr.TextDocument("\n".join(lines)))
 
     def _positions(self) -> np.ndarray | None:

@@ -47,6 +47,7 @@ def run_embodied(args) -> dict:
     config = EmbodiedConfig(
         speed_m_s=args.speed, collision_avoidance=not args.no_collision_avoidance,
         launch_interval_s=args.launch_interval, launch_order=order,
+        radio_range_m=args.radio_range,
         max_sim_time_s=args.max_time or EmbodiedConfig.max_sim_time_s)
     progress = sys.stderr.isatty()
     if args.record:
@@ -113,6 +114,10 @@ def register(subparsers) -> None:
     embodied.add_argument("--launch-order", default=None, metavar="I,J,...",
                           help="order in which robots R1..RK are put on the root, e.g. "
                                "3,1,2 (default: 1,2,...)")
+    embodied.add_argument("--radio-range", type=float, default=None, metavar="M",
+                          help="give the robots radios of this range (m, walls block) and "
+                               "let them keep connectivity tables (seed 004) while they move; "
+                               "reports messages and how often beliefs matched the truth")
     embodied.add_argument("--record", default=None, metavar="FILE.rrd",
                           help="write a rerun recording of the run (open it with "
                                "`mjswarm view FILE.rrd`)")
@@ -154,6 +159,11 @@ def summary(result: dict) -> str:
             (f"collisions: {result['collisions']} robot-robot contact events; "
             f"speed changes (eq. 27): {result['speed_changes']}"),
         ]
+        if result["radio_messages"] is not None:
+            lines.append(
+                f"radio: {result['radio_messages']} messages (busiest robot "
+                f"{result['radio_max_messages_per_robot']}); beliefs matched the truth in "
+                f"{100 * (result['radio_belief_agreement'] or 0):.1f} % of samples")
         if result["recording"]:
             lines.append(f"recording: {result['recording']}")
     return "\n".join(lines)
