@@ -217,7 +217,7 @@ class Radio:
         pairs: Iterable[tuple[Hashable, Hashable]]
         if self.range_m is None:
             pairs = [tuple(e) for e in self._edges or () if all(r in self._present for r in e)]
-        elif not self._positions:
+        elif not self._positions or not present:
             pairs = []
         else:
             xy = np.stack([self._positions[r] for r in present])

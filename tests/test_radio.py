@@ -215,3 +215,11 @@ def test_misuse_errors():
         Radio("ab", edges=[]).move({"a": (0, 0), "b": (0, 0)})
     with pytest.raises(MjswarmError, match="explicit edges"):
         Radio("ab", range_m=1.0).set_edges([])
+
+
+def test_removing_the_last_robot_leaves_an_empty_radio():
+    radio = Radio(["a", "b"], range_m=1.0)
+    radio.step({"a": (0, 0), "b": (0.5, 0)})
+    radio.remove("a")
+    radio.remove("b")
+    assert radio.present == () and radio.graph().number_of_nodes() == 0
