@@ -199,7 +199,7 @@ class EmbodiedExploration:
                 shown = now
                 bar.set_postfix(edges=sum(len(p) - 1 for p in self.paths))
         bar.close()
-        return self._result(time.perf_counter() - start)
+        return self.result(time.perf_counter() - start)
 
     def step(self) -> None:
         """One control tick: launch, sense, decide, act, simulate."""
@@ -379,7 +379,8 @@ class EmbodiedExploration:
             self.recorder.log_event(self.sim.step_count, self.sim.time_s, text, i)
 
     # ------------------------------------------------------------------ metrics
-    def _result(self, wall: float) -> EmbodiedResult:
+    def result(self, wall: float = 0.0) -> EmbodiedResult:
+        """The measurements so far (``wall``: wall-clock seconds spent, for the rates)."""
         per_robot = [len(p) - 1 for p in self.paths]
         map_edges: list[tuple[str, str]] = []
         declared_by = declared_at = None

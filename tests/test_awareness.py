@@ -19,7 +19,7 @@ def test_tables_follow_the_moving_radio_graph():
         run.step()
         if run.sim.step_count % 10 == 0:
             seen.update(run.awareness.truth().values())
-    result = run._result(1.0)
+    result = run.result()
     assert result.completed
     assert seen == {"biconnected", "not"}  # the truth changed while they moved
     assert result.radio_belief_agreement > 0.98  # beliefs lag the truth by a few ticks
