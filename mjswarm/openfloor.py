@@ -39,10 +39,12 @@ class MotionWorld(ABC):
             floor (the rest wait in the depot).
         seed: seeds the position-sensor noise.
         position_noise_m, heading_noise_rad: standard deviations of the positioning sensor.
+        omega_max_rad_s: turn-rate cap of the velocity tracker (a paper may set its own).
     """
 
     def __init__(self, positions: Sequence[tuple[float, float]], present: Sequence[bool] | None,
-                 seed: int, position_noise_m: float, heading_noise_rad: float) -> None:
+                 seed: int, position_noise_m: float, heading_noise_rad: float,
+                 omega_max_rad_s: float = OMEGA_MAX_RAD_S) -> None:
         if len(positions) < 1:
             raise MjswarmError("an open-floor world needs at least one robot")
         if position_noise_m < 0 or heading_noise_rad < 0:
@@ -51,6 +53,9 @@ class MotionWorld(ABC):
         self.present = np.ones(self.n, bool) if present is None else np.array(present, bool)
         self.rng = np.random.default_rng(seed)
         self.position_noise_m, self.heading_noise_rad = position_noise_m, heading_noise_rad
+        if omega_max_rad_s <= 0:
+            raise MjswarmError(f"turn-rate cap must be positive, got {omega_max_rad_s} rad/s")
+        self.omega_max_rad_s = omega_max_rad_s
         self.time_s = 0.0
 
     @abstractmethod
@@ -81,7 +86,7 @@ class MotionWorld(ABC):
         """Follow planar velocities (m/s, shape (N, 2)) for ``duration_s`` seconds."""
         velocities = np.asarray(velocities, float).reshape(self.n, 2)
         sensed = self.sense()
-        commands = [track_velocity(sensed[i, 2], velocities[i], V_MAX_M_S, OMEGA_MAX_RAD_S)
+        commands = [track_velocity(sensed[i, 2], velocities[i], V_MAX_M_S, self.omega_max_rad_s)
                     if self.present[i] else (0.0, 0.0) for i in range(self.n)]
         v, omega = (np.array(c) for c in zip(*commands))
         self._advance(v, omega, duration_s)
@@ -92,8 +97,10 @@ class PointWorld(MotionWorld):
     """Kinematic unicycles: exact integration of ``(v, omega)``, no bodies, no contacts."""
 
     def __init__(self, positions, present=None, seed=0, position_noise_m=0.0,
-                 heading_noise_rad=0.0, dt_s: float = 0.02) -> None:
-        super().__init__(positions, present, seed, position_noise_m, heading_noise_rad)
+                 heading_noise_rad=0.0, dt_s: float = 0.02,
+                 omega_max_rad_s: float = OMEGA_MAX_RAD_S) -> None:
+        super().__init__(positions, present, seed, position_noise_m, heading_noise_rad,
+                         omega_max_rad_s)
         self.dt_s = dt_s
         self._poses = np.zeros((self.n, 3))
         self._poses[:, :2] = np.asarray(positions, float)
@@ -122,11 +129,13 @@ class EmbodiedFloor(MotionWorld):
     """
 
     def __init__(self, positions, present=None, seed=0, position_noise_m=0.0,
-                 heading_noise_rad=0.0, floor_half_size_m: float = 10.0) -> None:
+                 heading_noise_rad=0.0, floor_half_size_m: float = 10.0,
+                 omega_max_rad_s: float = OMEGA_MAX_RAD_S) -> None:
         from mjswarm.simulation import Simulation
         from mjswarm.world import Pose2D, world_spec
 
-        super().__init__(positions, present, seed, position_noise_m, heading_noise_rad)
+        super().__init__(positions, present, seed, position_noise_m, heading_noise_rad,
+                         omega_max_rad_s)
         self._depot = [(-floor_half_size_m + 0.4 * i, -floor_half_size_m - 1.0)
                        for i in range(self.n)]
         poses = [Pose2D(*(positions[i] if self.present[i] else self._depot[i]), 0.0)

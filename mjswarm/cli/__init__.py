@@ -16,7 +16,7 @@ from mjswarm import __version__
 from mjswarm.errors import MjswarmError
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ("bench", "arena", "explore", "compare", "view", "connectivity", "sweep")
+SUBCOMMANDS = ("bench", "arena", "explore", "compare", "view", "connectivity", "experiment", "sweep")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,311 @@
+"""The patrol mission of Kobayashi, Higuchi & Ueno (seed 001, Sect. IV-B) on our robots.
+
+Robot 0 is the base station at the origin; robots 1..N-1 start at random in the fan
+``||x|| <= 0.6 sqrt(N)`` m, x, y >= 0 (the quadrant of the targets), at least 0.2 m
+apart and 0.2 m from the base station; the one closest to the base station is the local
+leader, the rest explorers; the draw is repeated until the network (base station - local
+leader link plus the Gabriel graph of the others within d_c) is connected. The base
+station is given a target drawn in ``[0, 1.8 sqrt(N)]^2`` m and a new one as soon as it
+hears the local leader's arrival; the mission lasts ``steps`` timesteps of
+``STEP_S`` = 0.15 s (1 paper unit = 1 m, so the paper's 0.03 unit/step cap is the Spark
+V's 0.2 m/s).
+
+Each step: the radio (:class:`mjswarm.radio.Radio`, range d_c) delivers last step's
+messages, every robot reads its sensors (detection within d_s of the positioning-sensor
+readings, with roles) and runs :class:`algorithms.maintenance.roles.RoleSwitchingRobot`,
+and the world follows the velocities for one step. Metrics (ground truth, not seen by
+the robots):
+
+* the *network* is the graph of mutual connections (``j in A_i`` and ``i in A_j``) no
+  longer than d_c; a *disconnection* is a maximal run of steps in which some robot is not
+  connected to the base station, and its length is its recovery time (Fig. 7); a
+  *leader gap* is such a run for the local leader alone;
+* processing time: wall time of each robot's controller call, per robot per step (s);
+* messages: copies received (radio counter) per robot per step;
+* algebraic connectivity (networkx) of the network, sampled every ``sample_every`` steps;
+* the AAT's cost as the robots ran it (``aat_robots``: Algorithm 2, or the baseline
+  with ``every_step_aat``; their own counters and time) and, on the same
+  positions every step, the every-step baseline run in the shadow (not used for
+  control), with the algebraic connectivity of the local-leader-and-explorer graph that
+  each gives (Fig. 4, 5).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+
+import networkx as nx
+import numpy as np
+
+from algorithms.maintenance.gabriel import gabriel_graph, refresh_connections
+from algorithms.maintenance.roles import (
+    FLOCK,
+    Detected,
+    Role,
+    RoleParams,
+    RoleSwitchingRobot,
+    Target,
+)
+from mjswarm.errors import MjswarmError
+from mjswarm.openfloor import EmbodiedFloor, MotionWorld, PointWorld
+from mjswarm.radio import Radio
+
+#: Duration of one paper timestep (s): 0.03 m/step = 0.2 m/s, 0.15 rad/step = 1 rad/s.
+STEP_S = 0.15
+#: Seed 001's turn-rate cap, 0.15 rad per timestep (Sect. III-C).
+PAPER_TURN_CAP_RAD_PER_STEP = 0.15
+WORLDS = ("embodied", "point")
+
+
+@dataclass
+class TrialResult:
+    """One mission. Times in seconds, lengths in metres, durations in steps."""
+
+    robots: int
+    steps: int
+    seed: int
+    world: str
+    disconnections: int
+    recovery_steps: list[int]
+    leader_gaps: list[int]
+    targets_reached: int
+    repeaters_final: int
+    processing_s_per_robot_step: float
+    processing_s_per_robot_step_by_role: dict[str, float]
+    messages_per_robot_step: float
+    algebraic_connectivity: float
+    aat_robots: dict[str, float]
+    aat_every_step: dict[str, float]
+    collisions: int | None
+    wall_s: float
+    history: dict[str, list] = field(default_factory=dict, repr=False)
+
+
+def initial_positions(n: int, rng: np.random.Generator, params: RoleParams,
+                      attempts: int = 1000) -> np.ndarray:
+    """Draw the deployment of Sect. IV-B (see the module docstring); (N, 2) in metres."""
+    if n < 3:
+        raise MjswarmError(f"the patrol needs at least 3 robots (base station, leader, "
+                           f"explorer), got {n}")
+    radius = 0.6 * math.sqrt(n)
+    for _ in range(attempts):
+        points = [np.zeros(2)]
+        while len(points) < n:
+            for _ in range(10_000):
+                r, a = radius * math.sqrt(rng.uniform()), rng.uniform(0.0, math.pi / 2)
+                p = np.array([r * math.cos(a), r * math.sin(a)])
+                if all(np.linalg.norm(p - q) >= 0.2 for q in points):
+                    points.append(p)
+                    break
+            else:
+                raise MjswarmError(f"cannot place {n} robots 0.2 m apart in the fan")
+        xy = np.array(points)
+        leader = 1 + int(np.argmin(np.linalg.norm(xy[1:], axis=1)))
+        g = nx.Graph()
+        g.add_nodes_from(range(n))
+        g.add_edges_from((a + 1, b + 1) for a, b in map(tuple, gabriel_graph(xy[1:], params.d_c)))
+        if np.linalg.norm(xy[leader]) <= params.d_c:
+            g.add_edge(0, leader)
+        if nx.is_connected(g):
+            return xy
+    raise MjswarmError(f"no connected deployment of {n} robots in {attempts} draws")
+
+
+def make_world(kind: str, positions: np.ndarray, seed: int) -> MotionWorld:
+    """The point world or the MuJoCo floor, sized for the target area."""
+    omega = PAPER_TURN_CAP_RAD_PER_STEP / STEP_S  # the paper's 0.15 rad/step
+    if kind == "point":
+        return PointWorld([tuple(p) for p in positions], seed=seed, omega_max_rad_s=omega)
+    if kind == "embodied":
+        half = 1.8 * math.sqrt(len(positions)) + 4.0
+        return EmbodiedFloor([tuple(p) for p in positions], seed=seed, floor_half_size_m=half,
+                             omega_max_rad_s=omega)
+    raise MjswarmError(f"unknown world {kind!r} (choose from {', '.join(WORLDS)})")
+
+
+def network_graph(minds: list[RoleSwitchingRobot], xy: np.ndarray, d_c: float) -> nx.Graph:
+    """Mutual connections no longer than ``d_c`` (ground-truth positions ``xy``, m)."""
+    g = nx.Graph()
+    g.add_nodes_from(range(len(minds)))
+    for i, m in enumerate(minds):
+        for j in m.connections:
+            if j > i and i in minds[j].connections and np.linalg.norm(xy[i] - xy[j]) <= d_c:
+                g.add_edge(i, j)
+    return g
+
+
+def _runs(flags: list[bool]) -> list[int]:
+    """Lengths of the maximal runs of True in ``flags``."""
+    runs, length = [], 0
+    for f in flags:
+        if f:
+            length += 1
+        elif length:
+            runs.append(length)
+            length = 0
+    return runs + ([length] if length else [])
+
+
+def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
+              params: RoleParams | None = None, every_step_aat: bool = False,
+              sample_every: int = 10, progress: Callable[[int], None] | None = None,
+              keep_history: bool = False) -> TrialResult:
+    """One patrol mission of ``steps`` timesteps with ``robots`` robots (base station
+    included). ``every_step_aat`` drives the robots with the baseline instead of
+    Algorithm 2."""
+    params = params or RoleParams()
+    if steps < 1 or sample_every < 1:
+        raise MjswarmError("steps and sample interval must be at least 1")
+    started = time.perf_counter()
+    rng = np.random.default_rng(seed)
+    xy0 = initial_positions(robots, rng, params)
+    leader = 1 + int(np.argmin(np.linalg.norm(xy0[1:], axis=1)))
+    minds = [RoleSwitchingRobot(i, Role.EXPLORER, params, every_step_aat=every_step_aat)
+             for i in range(robots)]
+    minds[0] = RoleSwitchingRobot(0, Role.BASE_STATION, params, child=leader)
+    minds[leader] = RoleSwitchingRobot(leader, Role.LOCAL_LEADER, params, parent=0,
+                                       every_step_aat=every_step_aat)
+    minds[0].connections, minds[leader].connections = {leader}, {0}
+    side = 1.8 * math.sqrt(robots)
+    minds[0].target = Target(0, tuple(rng.uniform(0.0, side, 2)))
+    floor = make_world(world, xy0, seed)
+    radio = Radio(range(robots), range_m=params.d_c, rng=seed)
+    cpu = np.zeros(robots)
+    cpu_by_role: dict[str, list[float]] = {r.value: [0.0, 0] for r in Role}
+    shadow = {"angle_tests": 0, "seconds": 0.0}
+    targets = 0
+    cut, leader_cut, lam, lam_alg2, lam_base = [], [], [], [], []
+    history: dict[str, list] = {"positions": [], "roles": [], "edges": []}
+    for t in range(steps):
+        truth = floor.true_positions()
+        radio.step({i: truth[i] for i in range(robots)})
+        sensed = floor.sense()[:, :2]
+        roles = [m.role for m in minds]
+        dist = np.linalg.norm(sensed[:, None, :] - sensed[None, :, :], axis=-1)
+        velocities = np.zeros((robots, 2))
+        flock_base = nx.Graph()
+        for i, mind in enumerate(minds):
+            seen = np.flatnonzero((dist[i] <= params.d_s) & (np.arange(robots) != i))
+            detected = {int(k): Detected(sensed[k], roles[k]) for k in seen}
+            inbox = [(msg.sender, msg.payload) for msg in radio.receive(i)]
+            t0 = time.perf_counter()
+            u, out = mind.tick(t, sensed[i], detected, inbox)
+            elapsed = time.perf_counter() - t0
+            cpu[i] += elapsed
+            cpu_by_role[mind.role.value][0] += elapsed
+            cpu_by_role[mind.role.value][1] += 1
+            for to, payload in out:
+                radio.send(i, payload, to=to)
+            velocities[i] = u / STEP_S
+            if roles[i] in FLOCK:
+                candidates = {k: d.x for k, d in detected.items() if d.role in FLOCK}
+                t0 = time.perf_counter()
+                base = refresh_connections(sensed[i], (), candidates, range_m=params.d_c,
+                                           eta_c=params.eta_c, force_full=True)
+                shadow["seconds"] += time.perf_counter() - t0
+                shadow["angle_tests"] += base.angle_tests
+                if t % sample_every == 0:
+                    flock_base.add_node(i)
+                    flock_base.add_edges_from((i, k) for k in base.connections)
+        g = network_graph(minds, truth, params.d_c)
+        reach = nx.node_connected_component(g, 0)
+        cut.append(len(reach) < robots)
+        leaders = [i for i, m in enumerate(minds) if m.role is Role.LOCAL_LEADER]
+        leader_cut.append(not leaders or leaders[0] not in reach)
+        if t % sample_every == 0:
+            lam.append(nx.algebraic_connectivity(g, method="tracemin_lu"))
+            flock = [i for i, m in enumerate(minds) if m.role in FLOCK]
+            flock_alg2 = g.subgraph(flock)
+            for h, out_list in ((flock_alg2, lam_alg2), (flock_base, lam_base)):
+                out_list.append(nx.algebraic_connectivity(h, method="tracemin_lu")
+                                if h.number_of_nodes() > 1 else 0.0)
+            if keep_history:
+                history["positions"].append(truth.tolist())
+                history["roles"].append([m.role.value for m in minds])
+                history["edges"].append(sorted(g.edges()))
+        base_station = minds[0]
+        if base_station.target is not None and base_station.arrived >= base_station.target.seq:
+            targets += 1
+            base_station.target = Target(base_station.target.seq + 1,
+                                         tuple(rng.uniform(0.0, side, 2)))
+        floor.step(velocities, STEP_S)
+        if progress is not None:
+            progress(1)
+    robot_steps = robots * steps
+    angle_alg2 = sum(m.angle_tests for m in minds)
+    circle_alg2 = sum(m.circle_tests for m in minds)
+    return TrialResult(
+        robots=robots, steps=steps, seed=seed, world=world,
+        disconnections=len(_runs(cut)), recovery_steps=_runs(cut),
+        leader_gaps=_runs(leader_cut), targets_reached=targets,
+        repeaters_final=sum(m.role is Role.REPEATER for m in minds),
+        processing_s_per_robot_step=float(cpu.sum() / robot_steps),
+        processing_s_per_robot_step_by_role={
+            r: (s / k if k else None) for r, (s, k) in cpu_by_role.items()},
+        messages_per_robot_step=sum(radio.received.values()) / robot_steps,
+        algebraic_connectivity=float(np.mean(lam)),
+        aat_robots={"angle_tests_per_robot_step": angle_alg2 / robot_steps,
+                  "circle_tests_per_robot_step": circle_alg2 / robot_steps,
+                  "tests_per_robot_step": (angle_alg2 + circle_alg2) / robot_steps,
+                  "seconds_per_robot_step": sum(m.aat_seconds for m in minds) / robot_steps,
+                  "algebraic_connectivity": float(np.mean(lam_alg2))},
+        aat_every_step={"angle_tests_per_robot_step": shadow["angle_tests"] / robot_steps,
+                        "seconds_per_robot_step": shadow["seconds"] / robot_steps,
+                        "algebraic_connectivity": float(np.mean(lam_base))},
+        collisions=(floor.sim.collisions.count if isinstance(floor, EmbodiedFloor) else None),
+        wall_s=time.perf_counter() - started,
+        history=history if keep_history else {},
+    )
+
+
+def summarize(trials: list[TrialResult]) -> dict:
+    """Means over trials (the paper's Fig. 4, 5, 7, 10, 11 quantities) plus the trials."""
+    def mean(values):
+        values = [v for v in values if v is not None]
+        return float(np.mean(values)) if values else None
+
+    recoveries = [np.mean(t.recovery_steps) for t in trials if t.recovery_steps]
+    return {
+        "robots": trials[0].robots,
+        "trials": len(trials),
+        "steps": trials[0].steps,
+        "world": trials[0].world,
+        "disconnections_per_trial": mean([t.disconnections for t in trials]),
+        "mean_recovery_steps": mean(recoveries),
+        "max_recovery_steps": max((max(t.recovery_steps) for t in trials if t.recovery_steps),
+                                  default=0),
+        "disconnected_steps_per_trial": mean([sum(t.recovery_steps) for t in trials]),
+        "leader_gaps_per_trial": mean([len(t.leader_gaps) for t in trials]),
+        "max_leader_gap_steps": max((max(t.leader_gaps) for t in trials if t.leader_gaps),
+                                    default=0),
+        "targets_per_trial": mean([t.targets_reached for t in trials]),
+        "processing_s_per_robot_step": mean([t.processing_s_per_robot_step for t in trials]),
+        "processing_s_per_robot_step_by_role": {
+            r: mean([t.processing_s_per_robot_step_by_role[r] for t in trials])
+            for r in trials[0].processing_s_per_robot_step_by_role},
+        "messages_per_robot_step": mean([t.messages_per_robot_step for t in trials]),
+        "algebraic_connectivity": mean([t.algebraic_connectivity for t in trials]),
+        "aat_robots": {k: mean([t.aat_robots[k] for t in trials]) for k in trials[0].aat_robots},
+        "aat_every_step": {k: mean([t.aat_every_step[k] for t in trials])
+                           for k in trials[0].aat_every_step},
+        "collisions_per_trial": mean([t.collisions for t in trials]),
+        "wall_s": float(sum(t.wall_s for t in trials)),
+        "per_trial": [{k: v for k, v in asdict(t).items() if k != "history"} for t in trials],
+    }
+
+
+def run_patrol(robots: int, trials: int = 1, seed: int = 0, world: str = "embodied",
+               steps: int = 2000, params: RoleParams | None = None,
+               every_step_aat: bool = False,
+               progress: Callable[[int], None] | None = None) -> dict:
+    """``trials`` missions (seeds ``seed .. seed + trials - 1``), summarised."""
+    if trials < 1:
+        raise MjswarmError(f"need at least one trial, got {trials}")
+    if world not in WORLDS:
+        raise MjswarmError(f"unknown world {world!r} (choose from {', '.join(WORLDS)})")
+    results = [run_trial(robots, seed + k, world, steps, params, every_step_aat,
+                         progress=progress) for k in range(trials)]
+    return summarize(results)
