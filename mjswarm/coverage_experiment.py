@@ -30,10 +30,13 @@ clear (no extra random draws, so both worlds see the same episodes). One control
 0.1 s.
 
 Bodies: in the embodied world robots keep ``CLEARANCE_M`` = 0.25 m centre to centre
-(chassis 0.15 m wide): they hold apart when region centres come closer and detour around
-each other (:func:`algorithms.maintenance.biconnected.detour`); an episode has settled when
-every robot is at its hold point. Points need no clearance (0), so the point world runs
-the paper's algorithm unchanged. Coverage is always computed from the region centres.
+(chassis 0.15 m wide): they hold apart when region centres come closer
+(:func:`algorithms.maintenance.regions.hold_points`) and drive around the hold points
+they know (:func:`algorithms.maintenance.regions.path_around`); an episode has settled
+when every robot is at its hold point. Points need no clearance (0), so the point world
+runs the paper's algorithm unchanged. Coverage is always computed from the region
+centres; the radio and the distributed check see where the robots really hold, so the
+two worlds' coverages can differ after a removal.
 """
 
 from __future__ import annotations
