@@ -19,6 +19,12 @@ from mjswarm.errors import MjswarmError
 SUBCOMMANDS = ("bench", "arena", "explore", "compare", "view", "connectivity", "experiment", "sweep")
 
 
+def register_modules(subparsers, prefix: str, names: tuple[str, ...]) -> None:
+    """Let each module ``mjswarm.cli.<prefix><name>`` add its parser to ``subparsers``."""
+    for name in names:
+        importlib.import_module(f"mjswarm.cli.{prefix}{name}").register(subparsers)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="mjswarm",
@@ -26,8 +32,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"mjswarm {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in SUBCOMMANDS:
-        importlib.import_module(f"mjswarm.cli.{name}").register(subparsers)
+    register_modules(subparsers, "", SUBCOMMANDS)
     return parser
 
 

@@ -6,7 +6,7 @@ Each comparison is a module ``mjswarm.cli.compare_<what>`` exposing
 
 from __future__ import annotations
 
-import importlib
+from mjswarm.cli import register_modules
 
 #: Comparison modules (``mjswarm.cli.compare_<name>``).
 COMPARISONS: tuple[str, ...] = ("exploration", "connectivity")
@@ -19,5 +19,4 @@ def register(subparsers) -> None:
         description="Rerun a paper's comparison and write a table plus PNG plots.",
     )
     comparisons = parser.add_subparsers(dest="comparison", metavar="WHAT", required=True)
-    for name in COMPARISONS:
-        importlib.import_module(f"mjswarm.cli.compare_{name}").register(comparisons)
+    register_modules(comparisons, "compare_", COMPARISONS)

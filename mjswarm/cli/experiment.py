@@ -6,7 +6,7 @@ Each experiment is a module ``mjswarm.cli.experiment_<name>`` exposing
 
 from __future__ import annotations
 
-import importlib
+from mjswarm.cli import register_modules
 
 #: Experiment modules (``mjswarm.cli.experiment_<name>``).
 EXPERIMENTS: tuple[str, ...] = ("biconnected_coverage", "patrol")
@@ -19,5 +19,4 @@ def register(subparsers) -> None:
         description="Rerun a paper's experiment (embodied MuJoCo robots or kinematic points).",
     )
     experiments = parser.add_subparsers(dest="experiment", metavar="NAME", required=True)
-    for name in EXPERIMENTS:
-        importlib.import_module(f"mjswarm.cli.experiment_{name}").register(experiments)
+    register_modules(experiments, "experiment_", EXPERIMENTS)
