@@ -19,8 +19,6 @@ for controllers. A run is a pure function of the world and the command sequence,
 
 from __future__ import annotations
 
-import math
-
 import mujoco
 import numpy as np
 
@@ -36,7 +34,7 @@ from mjswarm.robot import (
     WHEEL_SPEED_SENSORS,
     measure_geometry,
 )
-from mjswarm.world import Pose2D
+from mjswarm.world import Pose2D, yaw_quat
 
 #: One robot's sensor record: line rangefinders (m), IR distances (m, NaN = nothing
 #: within range), wheel encoders (rad), wheel speeds (rad/s), battery voltage (V).
@@ -164,7 +162,7 @@ class Simulation:
         dof = self.model.jnt_dofadr[self.model.body_jntadr[self.robot_bodies[i]]]
         q = self.data.qpos
         q[adr:adr + 2] = pose.x, pose.y
-        q[adr + 3:adr + 7] = math.cos(pose.yaw / 2), 0.0, 0.0, math.sin(pose.yaw / 2)
+        q[adr + 3:adr + 7] = yaw_quat(pose.yaw)
         self.data.qvel[dof:dof + 6] = 0.0
         self.data.ctrl[self._actuators[i]] = 0.0
         mujoco.mj_forward(self.model, self.data)  # sensors see the robot where it now is
@@ -238,7 +236,3 @@ class Simulation:
             if w.number > 0
         }
 
-
-def wrap_angle(angle_rad: float) -> float:
-    """Wrap an angle to (-pi, pi]."""
-    return math.atan2(math.sin(angle_rad), math.cos(angle_rad))

@@ -70,7 +70,8 @@ def _segment_frame(start: Sequence[float], end: Sequence[float]) -> tuple[np.nda
     return (a + b) / 2.0, length / 2.0, math.atan2(delta[1], delta[0])
 
 
-def _yaw_quat(yaw: float) -> list[float]:
+def yaw_quat(yaw: float) -> list[float]:
+    """Unit quaternion (w, x, y, z) of a rotation by ``yaw`` (rad) about +z."""
     return [math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0)]
 
 
@@ -117,18 +118,18 @@ def world_spec(
         spec.worldbody.add_geom(
             name=f"strip{i}", type=mujoco.mjtGeom.mjGEOM_BOX, group=STRIP_GROUP,
             contype=0, conaffinity=0, rgba=STRIP_RGBA,
-            pos=[mid[0], mid[1], strip.thickness_m / 2.0], quat=_yaw_quat(yaw),
+            pos=[mid[0], mid[1], strip.thickness_m / 2.0], quat=yaw_quat(yaw),
             size=[half_len, strip.width_m / 2.0, strip.thickness_m / 2.0],
         )
     for i, wall in enumerate(walls):
         mid, half_len, yaw = _segment_frame(wall.start, wall.end)
         spec.worldbody.add_geom(
             name=f"wall{i}", type=mujoco.mjtGeom.mjGEOM_BOX, rgba=WALL_RGBA,
-            pos=[mid[0], mid[1], wall.height_m / 2.0], quat=_yaw_quat(yaw),
+            pos=[mid[0], mid[1], wall.height_m / 2.0], quat=yaw_quat(yaw),
             size=[half_len, wall.thickness_m / 2.0, wall.height_m / 2.0],
         )
     template = robot.body(ROOT_BODY)
     for i, pose in enumerate(poses):
-        frame = spec.worldbody.add_frame(pos=[pose.x, pose.y, 0.0], quat=_yaw_quat(pose.yaw))
+        frame = spec.worldbody.add_frame(pos=[pose.x, pose.y, 0.0], quat=yaw_quat(pose.yaw))
         frame.attach_body(template, f"r{i}/", "")
     return spec

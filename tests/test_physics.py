@@ -9,7 +9,7 @@ import pytest
 
 from mjswarm.errors import MjswarmError
 from mjswarm.robot import load_robot_spec
-from mjswarm.simulation import Simulation, wrap_angle
+from mjswarm.simulation import Simulation
 from mjswarm.world import FloorStrip, Pose2D, WallSegment, world_spec
 
 SETTLE_S = 1.0
@@ -29,7 +29,7 @@ def test_straight_drive_speed_and_heading(one_robot, speed):
     end = one_robot.poses()[0]
     measured = np.hypot(*(end[:2] - start[:2])) / (one_robot.time_s - t0)
     assert measured == pytest.approx(speed, rel=0.05)
-    assert abs(math.degrees(wrap_angle(end[2] - start[2]))) < 2.0
+    assert abs(math.degrees(math.remainder(end[2] - start[2], 2 * math.pi))) < 2.0
     assert abs(end[1] - start[1]) < 0.035  # 2 degrees over 1 m
 
 
@@ -50,7 +50,7 @@ def test_turn_in_place_matches_kinematics(one_robot, omega):
     for _ in range(100):
         previous = one_robot.poses()[0, 2]
         one_robot.step()
-        total += wrap_angle(one_robot.poses()[0, 2] - previous)
+        total += math.remainder(one_robot.poses()[0, 2] - previous, 2 * math.pi)
     rate = total / (one_robot.time_s - t0)
     assert rate == pytest.approx(omega, rel=0.05)
     assert np.hypot(*one_robot.poses()[0, :2]) < 0.01  # turned on the spot
