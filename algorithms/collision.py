@@ -99,18 +99,18 @@ class CollisionRule:
 
     def __post_init__(self) -> None:
         self.speed = self.initial_speed
+        # least-squares slope over a full window as fixed weights on the samples:
+        # sum_i (i - t_mean) (b_i - b_mean) / sum_i (i - t_mean)^2, divided by dt
+        t_mean = (self.window - 1) / 2.0
+        den = sum((i - t_mean) ** 2 for i in range(self.window))
+        self._slope_weights = tuple((i - t_mean) / den / self.dt for i in range(self.window))
 
     def bearing_rate(self, p: int) -> float | None:
         """Least-squares slope (rad/s) of ``beta_kp`` over the window, None if too short."""
         samples = self._history.get(p)
         if samples is None or len(samples) < self.window:
             return None
-        n = len(samples)
-        t_mean = (n - 1) / 2.0
-        b_mean = sum(samples) / n
-        num = sum((i - t_mean) * (b - b_mean) for i, b in enumerate(samples))
-        den = sum((i - t_mean) ** 2 for i in range(n))
-        return num / den / self.dt
+        return sum(w * b for w, b in zip(self._slope_weights, samples))
 
     def update(self, bearings: dict[int, float]) -> float:
         """Take this tick's bearings ``{p: beta_kp}`` (rad) and return ``S_k`` (m/s)."""

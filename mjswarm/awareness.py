@@ -2,7 +2,7 @@
 
 With ``--radio-range R`` an embodied run gives every robot a radio (:class:`mjswarm.radio.
 Radio`: range ``R``, one control tick of latency, links blocked by walls through
-:func:`mjswarm.bearing.line_of_sight`) and a connectivity table of internally disjoint
+:func:`mjswarm.bearing.line_of_sight`, vectorised over pairs) and a connectivity table of internally disjoint
 access paths to the reference robot R1 (seed 004, :class:`algorithms.connectivity.tables.
 ConnectivityTable`), updated every control tick as links appear (table exchange) and break
 (Link-Broken) while the robots move.
@@ -45,7 +45,8 @@ class TableAwareness:
                  line_of_sight: bool = True) -> None:
         self.sim = sim
         self.reference = reference
-        blocked = (lambda i, j: not _mutual_sight(sim, i, j)) if line_of_sight else None
+        blocked = ((lambda pairs: ~mutual_sight(sim, *np.asarray(pairs, np.int64).reshape(-1, 2).T))
+                   if line_of_sight else None)
         self.radio = Radio(range(sim.n), range_m=range_m, blocked=blocked)
         self.tables = {i: ConnectivityTable(i, reference) for i in range(sim.n)}
         self.now = 0
@@ -89,5 +90,6 @@ class TableAwareness:
         return self.agree / self.samples if self.samples else None
 
 
-def _mutual_sight(sim: Simulation, i: int, j: int) -> bool:
-    return line_of_sight(sim, i, j) and line_of_sight(sim, j, i)
+def mutual_sight(sim: Simulation, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """Per pair: each robot of the pair sees the other (a link needs both directions)."""
+    return line_of_sight(sim, i, j) & line_of_sight(sim, j, i)

@@ -3,22 +3,25 @@
 Modelled on an omnidirectional IR beacon receiver with robot identification (each
 robot's beacon is modulated with its id): robot ``k`` sees robot ``p`` when ``p`` is within
 ``range_m`` and inside the field of view ``|beta| <= fov_rad`` around ``k``'s heading, and
-nothing blocks the line of sight (an ``mj_ray`` from ``k``'s centre, at ``RAY_HEIGHT_M``,
-towards ``p`` hits ``p`` first; only collision geoms, group 0, block: walls and robots).
+nothing blocks the line of sight (a ray from ``k``'s centre, at ``RAY_HEIGHT_M``, towards
+``p`` hits ``p`` first; only collision geoms, group 0, block: walls and robots).
 The reading is ``beta_kp``: the angle from ``k``'s heading to ``p`` (rad, CCW positive),
 plus optional Gaussian noise. Defaults: +-60 degrees, 1 m.
 
 Sampled at the control rate from the simulated world; controllers receive only
-``{p: beta_kp}``.
+``{p: beta_kp}``. O(N) for bounded density: candidate pairs come from a k-d tree of the
+robots' positions (``cKDTree.query_pairs``), and the line-of-sight rays are cast by the
+simulation's :class:`~mjswarm.raycast.RayCaster`, which answers as ``mj_ray`` does.
 """
 
 from __future__ import annotations
 
 import math
 
-import mujoco
 import numpy as np
+from scipy.spatial import cKDTree
 
+from mjswarm.raycast import Rays
 from mjswarm.simulation import Simulation
 
 RAY_HEIGHT_M = 0.06  # above the wheels (0.05 m), inside the chassis (0.012..0.07 m)
@@ -43,29 +46,43 @@ class BearingSensor:
         sim = self.sim
         poses = sim.poses() if poses is None else poses
         n = len(poses)
-        diff = poses[None, :, :2] - poses[:, None, :2]  # [k, p] = p - k
-        dist = np.hypot(diff[..., 0], diff[..., 1])
-        beta = np.arctan2(diff[..., 1], diff[..., 0]) - poses[:, None, 2]
+        pairs = cKDTree(poses[:, :2]).query_pairs(self.range_m, output_type="ndarray")
+        k = np.concatenate([pairs[:, 0], pairs[:, 1]])
+        p = np.concatenate([pairs[:, 1], pairs[:, 0]])
+        diff = poses[p, :2] - poses[k, :2]
+        beta = np.arctan2(diff[:, 1], diff[:, 0]) - poses[k, 2]
         beta = np.arctan2(np.sin(beta), np.cos(beta))
-        candidates = (dist <= self.range_m) & (np.abs(beta) <= self.fov_rad)
-        np.fill_diagonal(candidates, False)
+        ahead = np.abs(beta) <= self.fov_rad
+        k, p, beta = k[ahead], p[ahead], beta[ahead]
+        seen = line_of_sight(sim, k, p, poses)
+        k, p, beta = k[seen], p[seen], beta[seen]
+        order = np.lexsort((p, k))
+        k, p, beta = k[order], p[order], beta[order]
+        if self.noise_rad:
+            beta = beta + self.rng.normal(0.0, self.noise_rad, len(beta))
         out: list[dict[int, float]] = [{} for _ in range(n)]
-        for k, p in zip(*np.nonzero(candidates)):
-            if line_of_sight(sim, k, p, poses):
-                noise = self.rng.normal(0.0, self.noise_rad) if self.noise_rad else 0.0
-                out[k][int(p)] = float(beta[k, p] + noise)
+        for ki, pi, b in zip(k.tolist(), p.tolist(), beta.tolist()):
+            out[ki][pi] = b
         return out
 
 
 _GROUP0 = np.array([1, 0, 0, 0, 0, 0], dtype=np.uint8)
 
 
-def line_of_sight(sim: Simulation, k: int, p: int, poses: np.ndarray | None = None) -> bool:
-    """Whether robot ``p`` is the first thing a ray from robot ``k``'s centre towards it
-    hits (collision geoms only, at RAY_HEIGHT_M): walls and other robots block."""
+def line_of_sight(sim: Simulation, k: np.ndarray, p: np.ndarray,
+                  poses: np.ndarray | None = None) -> np.ndarray:
+    """For every pair ``(k[i], p[i])``: whether robot ``p`` is the first thing a ray from
+    robot ``k``'s centre towards it hits (collision geoms only, at RAY_HEIGHT_M): walls and
+    other robots block. Every geom of ``p`` lies within ``R`` of its centre, so a ray of
+    length ``|p - k| + R`` finds ``p`` if ``mj_ray`` would."""
     poses = sim.poses() if poses is None else poses
-    start = np.array([poses[k, 0], poses[k, 1], RAY_HEIGHT_M])
-    vec = np.array([poses[p, 0] - poses[k, 0], poses[p, 1] - poses[k, 1], 0.0])
-    geomid = np.zeros(1, dtype=np.int32)
-    mujoco.mj_ray(sim.model, sim.data, start, vec, _GROUP0, 1, int(sim.robot_bodies[k]), geomid)
-    return geomid[0] >= 0 and sim.geom_robot[geomid[0]] == p
+    k, p = np.asarray(k, np.int64), np.asarray(p, np.int64)
+    vec = poses[p, :2] - poses[k, :2]
+    dist = np.hypot(vec[:, 0], vec[:, 1])
+    apart = dist > 0
+    unit = np.column_stack([vec / np.where(apart, dist, 1.0)[:, None], np.zeros(len(k))])
+    unit[~apart, 0] = 1.0  # coincident robots: any direction, the answer is "no"
+    start = np.column_stack([poses[k, :2], np.full(len(k), RAY_HEIGHT_M)])
+    rays = Rays(start, unit, dist + sim.rays.robot_radius_m, k, sim.robot_bodies[k])
+    _, geom = sim.rays.cast(rays, _GROUP0)
+    return apart & (geom >= 0) & (sim.geom_robot[geom] == p)

@@ -3,9 +3,13 @@
 For each robot count N the benchmark builds one world (robots in a grid, each on its own
 floor strip, walls beside every row) and measures, in the same process and run:
 
-* ``realtime_factor``: simulated seconds per wall second of :meth:`Simulation.step`
-  with every sensor read at the control rate and a vectorised line-following controller
-  computing each robot's command from its own readings;
+* ``realtime_factor``: simulated seconds per wall second of the full control loop
+  (:class:`BenchTeam`): every robot's line, IR, encoder and wheel-speed readings, its
+  bearing sensor (+-60 degrees, 1 m, line of sight), a radio (range ``RADIO_RANGE_M``,
+  links need line of sight both ways) on which every robot broadcasts a heartbeat every
+  tick and reads its inbox, and per robot the seed-003 speed rule
+  (:class:`~algorithms.collision.CollisionRule`, bearing rates) setting the speed of a
+  line follower that steers from the robot's own line sensors;
 * ``physics_only_realtime_factor``: the same for bare ``mj_step`` on the same compiled
   model with sensors disabled and constant controls;
 * ``overhead_ratio``: their quotient (physics-only / full), i.e. how many times longer
@@ -21,7 +25,11 @@ from dataclasses import asdict, dataclass
 import mujoco
 import numpy as np
 
+from algorithms.collision import CollisionRule, epsilons
+from mjswarm.awareness import mutual_sight
+from mjswarm.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
+from mjswarm.radio import Radio
 from mjswarm.robot import DEFAULT_ROBOT_XML
 from mjswarm.simulation import Simulation
 from mjswarm.world import FloorStrip, Pose2D, WallSegment, world_spec
@@ -29,6 +37,7 @@ from mjswarm.world import FloorStrip, Pose2D, WallSegment, world_spec
 ROW_SPACING_M = 0.5
 COLUMN_SPACING_M = 0.6
 BENCH_SPEED_M_S = 0.1
+RADIO_RANGE_M = 1.0
 
 
 @dataclass(frozen=True)
@@ -36,6 +45,7 @@ class BenchResult:
     """Figures for one robot count (rates in simulated seconds per wall second)."""
 
     robots: int
+    sensing: str
     sim_seconds: float
     realtime_factor: float
     physics_only_realtime_factor: float
@@ -43,7 +53,7 @@ class BenchResult:
     robot_steps_per_s: float
 
 
-def bench_world(n: int, robot_xml: str = str(DEFAULT_ROBOT_XML)) -> Simulation:
+def bench_world(n: int, robot_xml: str = str(DEFAULT_ROBOT_XML), sensing: str = "auto") -> Simulation:
     """N robots in a near-square grid, each on a strip with a wall on its left."""
     if n < 1:
         raise MjswarmError(f"robot count must be >= 1, got {n}")
@@ -56,28 +66,53 @@ def bench_world(n: int, robot_xml: str = str(DEFAULT_ROBOT_XML)) -> Simulation:
         WallSegment((-0.5, r * ROW_SPACING_M + 0.13), (row_len, r * ROW_SPACING_M + 0.13))
         for r in range(rows)
     ]
-    return Simulation(world_spec(poses, strips, walls, robot_xml=robot_xml))
+    return Simulation(world_spec(poses, strips, walls, robot_xml=robot_xml), sensing=sensing)
 
 
-def line_following_command(sim: Simulation) -> tuple[np.ndarray, np.ndarray]:
-    """A proportional line follower over all robots: turn towards the darker side."""
+class BenchTeam:
+    """The full per-tick loop of N robots: sensing, bearings, radio, speed rule, steering."""
+
+    def __init__(self, sim: Simulation) -> None:
+        self.sim = sim
+        self.bearing = BearingSensor(sim)
+        self.radio = Radio(range(sim.n), range_m=RADIO_RANGE_M,
+                           blocked=lambda pairs: ~mutual_sight(sim, *np.asarray(pairs).reshape(-1, 2).T))
+        self.rules = [CollisionRule(BENCH_SPEED_M_S, e, dt=sim.control_dt_s) for e in epsilons(sim.n)]
+        self.heard = 0
+
+    def tick(self) -> None:
+        """Sense, communicate, decide and command every robot, then step the world once."""
+        sim = self.sim
+        poses = sim.poses()
+        self.radio.step(dict(enumerate(poses[:, :2])))
+        for i in range(sim.n):
+            self.heard += len(self.radio.receive(i))
+            self.radio.send(i, sim.step_count)
+        bearings = self.bearing.read(poses)
+        speed = np.array([rule.update(seen) for rule, seen in zip(self.rules, bearings)])
+        sim.set_velocity(speed, line_following_turn(sim))
+        sim.step()
+
+
+def line_following_turn(sim: Simulation) -> np.ndarray:
+    """A proportional line follower over all robots (rad/s): turn towards the darker side."""
     line = sim.readings()["line"]
     height = sim.geometry.line_sensor_height_m
     on = (height - line) > 0.001  # a strip under the sensor shortens the reading by 2 mm
-    steer = on[:, 0].astype(float) - on[:, 2].astype(float)
-    return np.full(sim.n, BENCH_SPEED_M_S), 0.8 * steer
+    return 0.8 * (on[:, 0].astype(float) - on[:, 2].astype(float))
 
 
-def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROBOT_XML)) -> BenchResult:
+def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROBOT_XML),
+              sensing: str = "auto") -> BenchResult:
     """Measure one robot count over ``sim_seconds`` of simulated time."""
     if sim_seconds <= 0:
         raise MjswarmError(f"benchmark duration must be positive, got {sim_seconds} s")
-    sim = bench_world(n, robot_xml)
+    sim = bench_world(n, robot_xml, sensing)
+    team = BenchTeam(sim)
     ticks = max(1, round(sim_seconds / sim.control_dt_s))
     start = time.perf_counter()
     for _ in range(ticks):
-        sim.set_velocity(*line_following_command(sim))
-        sim.step()
+        team.tick()
     full_wall = time.perf_counter() - start
 
     bare = bench_world(n, robot_xml)
@@ -91,6 +126,7 @@ def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROB
     simulated = ticks * sim.control_dt_s
     return BenchResult(
         robots=n,
+        sensing=sim.sensing,
         sim_seconds=simulated,
         realtime_factor=simulated / full_wall,
         physics_only_realtime_factor=simulated / bare_wall,

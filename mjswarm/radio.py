@@ -5,7 +5,7 @@ and 4; seed 004, section 2): identical ranges (so links are symmetric), a messag
 robot is heard by every robot within range d_c of it, and it arrives within one period c,
 which here is exactly one control tick. On top of that the radio can drop each copy of a
 message with probability ``drop_prob`` (seeded numpy Generator) and can block a link when
-line of sight is lost (an injected ``blocked(i, j) -> bool``: the embodied world passes an
+line of sight is lost (an injected, vectorised :data:`Blocker`: the embodied world passes an
 ``mj_ray``-based one, the static harness :func:`walls_blocker`). Per-robot counters give the
 papers' message complexities.
 
@@ -23,7 +23,14 @@ Choices the papers leave open:
   last :meth:`Radio.step`); it is delivered at the next ``step`` unless that copy is
   dropped or the recipient has left (:meth:`Radio.remove`).
 * A link exists iff the distance is at most d_c (inclusive) and ``blocked`` says it is not
-  blocked. Distances are Euclidean over whatever coordinates the positions have (metres).
+  blocked. Distances are Euclidean over whatever coordinates the positions have (metres);
+  the test is ``sum((p_i - p_j)**2) <= d_c**2`` in float64, and a robot with a non-finite
+  coordinate has no links.
+* Relinking costs O(N + P) for N robots and P in-range pairs (O(N) at bounded density): a
+  k-d tree (``scipy.spatial.cKDTree.query_pairs``, itself inclusive) proposes the pairs
+  within a radius enlarged by 1e-9 relative, and the exact squared-distance test above
+  decides, so the tree's own rounding cannot add or lose a link at exactly d_c. The
+  blocker is called once per relink with every in-range pair, in robot order.
 * ``send(..., to=j)`` is a broadcast that only robot ``j`` keeps (the papers' table
   exchange and reports): it costs one transmission and reaches ``j`` only if ``j`` is a
   neighbour. Counters count transmissions sent and copies received.
@@ -41,11 +48,16 @@ from typing import Any, NamedTuple
 
 import networkx as nx
 import numpy as np
+from scipy.spatial import cKDTree
 
 from mjswarm.errors import MjswarmError
 
-#: ``blocked(i, j) -> True`` when robots i and j cannot hear each other (no line of sight).
-Blocker = Callable[[Hashable, Hashable], bool]
+#: ``blocked(pairs) -> mask``: for a list of robot-id pairs ``(i, j)``, a bool array with one
+#: entry per pair, True when i and j cannot hear each other (no line of sight).
+Blocker = Callable[[list[tuple[Hashable, Hashable]]], np.ndarray]
+
+#: relative enlargement of the k-d tree's search radius over d_c (the exact test decides)
+_CANDIDATE_SLACK = 1e-9
 
 
 class Message(NamedTuple):
@@ -62,7 +74,8 @@ class Radio:
         robots: robot ids, in the order used for deterministic delivery.
         range_m: communication range d_c in metres (range mode).
         edges: explicit links ``(i, j)`` instead of a range (explicit-edge mode).
-        blocked: optional line-of-sight test ``blocked(i, j)``, asked for in-range pairs.
+        blocked: optional vectorised line-of-sight test (:data:`Blocker`), asked once per
+            relink with all in-range pairs.
         drop_prob: probability in [0, 1) that one copy of a message is lost.
         rng: numpy Generator or seed for the drops.
 
@@ -80,7 +93,8 @@ class Radio:
         rng: np.random.Generator | int | None = None,
     ) -> None:
         self.robots: tuple[Hashable, ...] = tuple(robots)
-        if len(set(self.robots)) != len(self.robots):
+        self._index: dict[Hashable, int] = {r: k for k, r in enumerate(self.robots)}
+        if len(self._index) != len(self.robots):
             raise MjswarmError("radio: duplicate robot ids")
         if (range_m is None) == (edges is None):
             raise MjswarmError("radio: give exactly one of a range (metres) or explicit edges")
@@ -213,25 +227,51 @@ class Radio:
                 self.received[r] += 1
 
     def _relink(self) -> None:
-        present = list(self._present)
-        pairs: Iterable[tuple[Hashable, Hashable]]
         if self.range_m is None:
             pairs = [tuple(e) for e in self._edges or () if all(r in self._present for r in e)]
-        elif not self._positions or not present:
-            pairs = []
+            ij = np.array([[self._index[i], self._index[j]] for i, j in pairs], dtype=np.intp)
         else:
-            xy = np.stack([self._positions[r] for r in present])
-            d2 = ((xy[:, None, :] - xy[None, :, :]) ** 2).sum(axis=-1)
-            ii, jj = np.nonzero(np.triu(d2 <= self.range_m**2, k=1))
-            pairs = [(present[i], present[j]) for i, j in zip(ii.tolist(), jj.tolist())]
-            if self.blocked is not None:
-                pairs = [(i, j) for i, j in pairs if not self.blocked(i, j)]
-        neighbors: dict[Hashable, set] = {r: set() for r in self.robots}
-        for i, j in pairs:
-            neighbors[i].add(j)
-            neighbors[j].add(i)
-        self._neighbors = {r: frozenset(s) for r, s in neighbors.items()}
-        self._ordered = {r: tuple(x for x in self.robots if x in s) for r, s in neighbors.items()}
+            ij = self._pairs_in_range()
+        self._set_links(ij.reshape(-1, 2))
+
+    def _pairs_in_range(self) -> np.ndarray:
+        """Linked pairs in range mode, as robot indices ``(k, l)``, k < l, sorted."""
+        present = list(self._present)
+        if not self._positions or not present:
+            return np.empty((0, 2), dtype=np.intp)
+        xy = np.stack([self._positions[r] for r in present])
+        rows = np.array([self._index[r] for r in present], dtype=np.intp)
+        finite = np.isfinite(xy).all(axis=1)
+        xy, rows = xy[finite], rows[finite]
+        near = cKDTree(xy).query_pairs(
+            self.range_m * (1.0 + _CANDIDATE_SLACK), output_type="ndarray"
+        ).reshape(-1, 2)
+        near = near[((xy[near[:, 0]] - xy[near[:, 1]]) ** 2).sum(axis=-1) <= self.range_m**2]
+        ij = rows[near]  # k < l: query_pairs gives i < j and ``rows`` increases
+        ij = ij[np.lexsort((ij[:, 1], ij[:, 0]))]
+        if self.blocked is not None and len(ij):
+            cut = np.asarray(
+                self.blocked([(self.robots[k], self.robots[m]) for k, m in ij.tolist()]),
+                dtype=bool,
+            )
+            if cut.shape != (len(ij),):
+                raise MjswarmError(
+                    f"radio: the blocker returned shape {cut.shape} for {len(ij)} pairs"
+                )
+            ij = ij[~cut]
+        return ij
+
+    def _set_links(self, ij: np.ndarray) -> None:
+        """Neighbour sets and, per robot, its neighbours in robot order, from index pairs."""
+        src = np.concatenate([ij[:, 0], ij[:, 1]])
+        dst = np.concatenate([ij[:, 1], ij[:, 0]])
+        order = np.lexsort((dst, src))
+        bounds = np.searchsorted(src[order], np.arange(len(self.robots) + 1)).tolist()
+        names = [self.robots[k] for k in dst[order].tolist()]
+        self._ordered = {
+            r: tuple(names[bounds[k] : bounds[k + 1]]) for k, r in enumerate(self.robots)
+        }
+        self._neighbors = {r: frozenset(t) for r, t in self._ordered.items()}
 
 
 def walls_blocker(
@@ -240,12 +280,14 @@ def walls_blocker(
 ) -> Blocker:
     """Line of sight for the static harness: 2-D wall segments block a link.
 
-    Returns ``blocked(i, j)``, true when the segment between the positions of robots i and j
-    (read from ``positions`` at call time, metres, x and y) meets any wall segment, touching
-    included. The embodied world uses an ``mj_ray``-based test instead.
+    Returns a :data:`Blocker`: for each pair ``(i, j)``, True when the segment between the
+    positions of robots i and j (read from ``positions`` at call time, metres, x and y) meets
+    any wall segment, touching included (the orientation test with collinear-overlap cases),
+    computed for all pairs x walls at once by numpy broadcasting. The embodied world uses an
+    ``mj_ray``-based test instead.
     """
     w = np.asarray([(a[0], a[1], b[0], b[1]) for a, b in walls], dtype=float).reshape(-1, 4)
-    c, d = w[:, 0:2], w[:, 2:4]
+    c, d = w[None, :, 0:2], w[None, :, 2:4]  # (1, walls, 2)
 
     def cross(o: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
         return (p[..., 0] - o[..., 0]) * (q[..., 1] - o[..., 1]) - (p[..., 1] - o[..., 1]) * (
@@ -260,11 +302,13 @@ def walls_blocker(
             q[..., 1] <= np.maximum(o[..., 1], p[..., 1])
         )
 
-    def blocked(i: Hashable, j: Hashable) -> bool:
-        if not len(w):
-            return False
-        a = np.broadcast_to(np.asarray(positions[i], dtype=float)[:2], c.shape)
-        b = np.broadcast_to(np.asarray(positions[j], dtype=float)[:2], c.shape)
+    def blocked(pairs: list[tuple[Hashable, Hashable]]) -> np.ndarray:
+        if not len(w) or not pairs:
+            return np.zeros(len(pairs), dtype=bool)
+        ends = np.array(
+            [(positions[i][:2], positions[j][:2]) for i, j in pairs], dtype=float
+        )  # (pairs, 2 ends, 2)
+        a, b = ends[:, None, 0], ends[:, None, 1]  # (pairs, 1, 2)
         d1, d2 = cross(c, d, a), cross(c, d, b)
         d3, d4 = cross(a, b, c), cross(a, b, d)
         proper = (d1 * d2 < 0) & (d3 * d4 < 0)
@@ -274,6 +318,6 @@ def walls_blocker(
             | ((d3 == 0) & on_segment(a, b, c))
             | ((d4 == 0) & on_segment(a, b, d))
         )
-        return bool(np.any(proper | touch))
+        return np.any(proper | touch, axis=1)
 
     return blocked

@@ -4,12 +4,25 @@
 :func:`mjswarm.world.world_spec`). Each control tick it
 
 1. writes the wheel-speed commands (rad/s) into ``data.ctrl``,
-2. advances physics ``substeps`` steps with ``mj_step(..., nstep=k)``; sensors are
-   disabled for all but the last physics step, so rangefinders (the expensive sensors)
-   are evaluated once per tick, on the state at the start of that last step (at most one
-   physics step, 2 ms, old),
+2. advances physics ``substeps`` steps with ``mj_step(..., nstep=k)``; sensors are read
+   once per tick, on the state at the start of the last physics step (at most one
+   physics step, 2 ms, old), as MuJoCo's own sensors in that step see it,
 3. reads every robot's sensors into one structured array (:meth:`readings`),
 4. updates the battery model and the robot-robot collision counter.
+
+Sensing comes in two interchangeable implementations (``sensing=``; the default
+``"auto"`` takes ``"mujoco"`` below ``GRID_SENSING_MIN_ROBOTS`` robots, where its O(N^2)
+costs less than the grid's fixed per-tick cost, and ``"grid"`` from there on):
+
+* ``"grid"`` (default), O(N): MuJoCo's sensor stage stays disabled; the rangefinders
+  declared in the robot model (site, direction = site z axis, ``cutoff``) are cast by
+  :class:`mjswarm.raycast.RayCaster` against nearby geoms only, and encoders and wheel
+  speeds are the wheel joints' ``qpos`` / ``qvel``, which is what MuJoCo's ``jointpos`` /
+  ``jointvel`` sensors return. A rangefinder without a cutoff is probed over
+  ``UNBOUNDED_PROBE_M`` and, if nothing is there (a tipped robot), re-cast with ``mj_ray``.
+* ``"mujoco"``: MuJoCo's sensors, evaluated in the last substep (every rangefinder tests
+  every geom: O(N^2)). The reference ``tests/test_raycast.py`` compares against: readings
+  are equal within 1e-9 on random states.
 
 Commands are wheel speeds or unicycle ``(v, omega)``; both are vectorised over robots.
 Ground-truth accessors (:meth:`poses`) exist for metrics, tests and recordings, never
@@ -25,6 +38,7 @@ import numpy as np
 from mjswarm.battery import Battery
 from mjswarm.contacts import CollisionCounter
 from mjswarm.errors import MjswarmError, one_line
+from mjswarm.raycast import RayCaster, Rays
 from mjswarm.robot import (
     ACTUATORS,
     ENCODERS,
@@ -48,6 +62,14 @@ READING_DTYPE = np.dtype(
     ]
 )
 
+SENSING = ("auto", "grid", "mujoco")
+#: Robot count from which ``sensing="auto"`` casts rays on the grid (``mjswarm bench
+#: --sensing grid`` and ``--sensing mujoco`` measure the two; README, "Benchmark").
+GRID_SENSING_MIN_ROBOTS = 32
+#: How far (m) grid sensing looks along a rangefinder that has no cutoff before it asks
+#: ``mj_ray``: beyond any line-sensor reading of an upright robot (0.02 m).
+UNBOUNDED_PROBE_M = 0.1
+
 
 class Simulation:
     """N robots stepping together.
@@ -57,7 +79,9 @@ class Simulation:
         control_hz: control / sensing rate (Hz); must divide the physics rate.
         seed: seeds the sensor noise generator.
         line_noise_m, ir_noise_m: standard deviation of Gaussian noise added to the line
-            and IR rangefinder readings (m); 0 by default.
+            and IR rangefinder readings (m) that saw something; 0 by default.
+        sensing: ``"grid"`` (O(N) ray casting), ``"mujoco"`` (MuJoCo's sensors) or
+            ``"auto"``; see the module docstring.
     """
 
     def __init__(
@@ -67,11 +91,14 @@ class Simulation:
         seed: int = 0,
         line_noise_m: float = 0.0,
         ir_noise_m: float = 0.0,
+        sensing: str = "auto",
     ) -> None:
         if control_hz <= 0:
             raise MjswarmError(f"control rate must be positive, got {control_hz} Hz")
         if line_noise_m < 0 or ir_noise_m < 0:
             raise MjswarmError("sensor noise standard deviations must be >= 0")
+        if sensing not in SENSING:
+            raise MjswarmError(f"sensing must be one of {', '.join(SENSING)}, got '{sensing}'")
         try:
             self.model = spec.compile()
         except ValueError as exc:
@@ -98,11 +125,13 @@ class Simulation:
 
         sens = mujoco.mjtObj.mjOBJ_SENSOR
         self._actuators = ids(mujoco.mjtObj.mjOBJ_ACTUATOR, ACTUATORS)
-        self._line_adr = m.sensor_adr[ids(sens, LINE_SENSORS)]
-        self._ir_adr = m.sensor_adr[ids(sens, IR_SENSORS)]
+        self._range_ids = ids(sens, LINE_SENSORS + IR_SENSORS)  # (N, 6): line, then IR
+        self._range_adr = m.sensor_adr[self._range_ids]
         self._enc_adr = m.sensor_adr[ids(sens, ENCODERS)]
         self._vel_adr = m.sensor_adr[ids(sens, WHEEL_SPEED_SENSORS)]
-        self._ir_cutoff = m.sensor_cutoff[ids(sens, IR_SENSORS)]
+        wheel_joints = m.sensor_objid[ids(sens, ENCODERS)]
+        self._wheel_qpos_adr = m.jnt_qposadr[wheel_joints]
+        self._wheel_dof_adr = m.jnt_dofadr[wheel_joints]
         self.robot_bodies = ids(mujoco.mjtObj.mjOBJ_BODY, (ROOT_BODY,))[:, 0]
         joints = m.body_jntadr[self.robot_bodies]
         self._qpos_adr = m.jnt_qposadr[joints]
@@ -112,12 +141,27 @@ class Simulation:
         self.geom_robot = geom_robot
         if self.n == 0:
             raise MjswarmError("a simulation needs at least one robot")
+        if sensing == "auto":
+            sensing = "grid" if self.n >= GRID_SENSING_MIN_ROBOTS else "mujoco"
+        self.sensing = sensing
         self.geometry = measure_geometry(m, "r0/")
         self.collisions = CollisionCounter(geom_robot)
         self.battery = Battery(self.n)
         self.step_count = 0
-        mujoco.mj_forward(m, self.data)
-        self._readings = self._read_sensors()
+        if sensing == "grid":
+            m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+            mujoco.mj_kinematics(m, self.data)
+        # a world grid sensing cannot cast fails here, in one line
+        self._rays = RayCaster(m, self.data, self.robot_bodies, geom_robot) if sensing == "grid" else None
+        self._sense_now()
+
+    @property
+    def rays(self) -> RayCaster:
+        """The O(N) ray caster for this world (rangefinders, bearing line of sight); with
+        ``sensing="mujoco"`` built on first use."""
+        if self._rays is None:
+            self._rays = RayCaster(self.model, self.data, self.robot_bodies, self.geom_robot)
+        return self._rays
 
     def _subtree(self, root: int) -> np.ndarray:
         """Body ids of ``root`` and all its descendants."""
@@ -165,7 +209,22 @@ class Simulation:
         q[adr + 3:adr + 7] = yaw_quat(pose.yaw)
         self.data.qvel[dof:dof + 6] = 0.0
         self.data.ctrl[self._actuators[i]] = 0.0
-        mujoco.mj_forward(self.model, self.data)  # sensors see the robot where it now is
+        self._sense_now()
+
+    def set_state(self, qpos: np.ndarray, qvel: np.ndarray) -> None:
+        """Put the whole world in a given state (the experimenter's hand) and sense it."""
+        m = self.model
+        qpos, qvel = np.asarray(qpos, float), np.asarray(qvel, float)
+        if qpos.shape != (m.nq,) or qvel.shape != (m.nv,):
+            raise MjswarmError(f"state needs qpos of shape ({m.nq},) and qvel of shape ({m.nv},), "
+                               f"got {qpos.shape} and {qvel.shape}")
+        self.data.qpos[:], self.data.qvel[:] = qpos, qvel
+        self._sense_now()
+
+    def _sense_now(self) -> None:
+        """Recompute kinematics (and MuJoCo's sensors, if on) and read every sensor."""
+        mujoco.mj_forward(self.model, self.data)
+        self._wheels = self._wheel_state()
         self._readings = self._read_sensors()
 
     # ------------------------------------------------------------------ stepping
@@ -177,27 +236,57 @@ class Simulation:
             if self.substeps > 1:
                 m.opt.disableflags |= sensor_bit
                 mujoco.mj_step(m, d, nstep=self.substeps - 1)
-                m.opt.disableflags &= ~sensor_bit
+                if self.sensing == "mujoco":
+                    m.opt.disableflags &= ~sensor_bit
+            self._wheels = self._wheel_state()  # the state the last step's sensors see
             mujoco.mj_step(m, d)
             self.step_count += 1
             self.battery.update(d.actuator_force[self._actuators], self.control_dt_s)
             self.collisions.update(d)
             self._readings = self._read_sensors()
 
+    def _wheel_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """Wheel angles (rad) and speeds (rad/s) now: the encoders' ``qpos`` / ``qvel``."""
+        return self.data.qpos[self._wheel_qpos_adr], self.data.qvel[self._wheel_dof_adr]
+
+    def _rangefinders(self) -> np.ndarray:
+        """Every rangefinder's distance (m), shape (N, 6) line then IR; NaN = nothing.
+
+        A hit at or beyond a sensor's cutoff is nothing, as is MuJoCo's miss (-1, or
+        -cutoff after its clamp).
+        """
+        m, d = self.model, self.data
+        cutoff = m.sensor_cutoff[self._range_ids]
+        if self.sensing == "mujoco":
+            raw = d.sensordata[self._range_adr]
+        else:
+            site = m.sensor_objid[self._range_ids].ravel()
+            length = np.where(cutoff > 0, cutoff, UNBOUNDED_PROBE_M).ravel()
+            robot = np.repeat(np.arange(self.n), self._range_ids.shape[1])
+            rays = Rays(d.site_xpos[site], d.site_xmat[site][:, 2::3].copy(), length, robot,
+                        m.site_bodyid[site])
+            dist, _ = self.rays.cast(rays)
+            for k in np.flatnonzero((dist < 0) & (cutoff.ravel() <= 0)):
+                dist[k] = mujoco.mj_ray(m, d, rays.origin[k], rays.direction[k], None, 1,
+                                        int(rays.exclude_body[k]), np.zeros(1, np.int32))
+            raw = dist.reshape(self._range_ids.shape)
+        return np.where((raw >= 0) & ((cutoff <= 0) | (raw < cutoff)), raw, np.nan)
+
     def _read_sensors(self) -> np.ndarray:
-        sd = self.data.sensordata
         out = np.empty(self.n, dtype=READING_DTYPE)
-        line = sd[self._line_adr]
-        ir = sd[self._ir_adr]
+        ranges = self._rangefinders()
+        line, ir = ranges[:, :3], ranges[:, 3:]
         if self.line_noise_m:
             line = line + self.rng.normal(0.0, self.line_noise_m, line.shape)
         if self.ir_noise_m:
             ir = ir + self.rng.normal(0.0, self.ir_noise_m, ir.shape)
-        # MuJoCo reads -cutoff on a miss and +cutoff for a hit beyond range: both "nothing".
         out["line"] = line
-        out["ir"] = np.where((ir >= 0.0) & (ir < self._ir_cutoff), ir, np.nan)
-        out["encoder"] = sd[self._enc_adr]
-        out["wheel_speed"] = sd[self._vel_adr]
+        out["ir"] = ir
+        if self.sensing == "mujoco":
+            sd = self.data.sensordata
+            out["encoder"], out["wheel_speed"] = sd[self._enc_adr], sd[self._vel_adr]
+        else:
+            out["encoder"], out["wheel_speed"] = self._wheels
         out["battery"] = self.battery.voltage_v
         return out
 

@@ -13,10 +13,17 @@ def test_bench_json_reports_every_key(capsys):
     assert main(["bench", "--robots", "1,3", "--seconds", "0.2", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert [r["robots"] for r in out["results"]] == [1, 3]
+    assert {r["sensing"] for r in out["results"]} == {"mujoco"}  # auto, small teams
     for r in out["results"]:
         assert r["realtime_factor"] > 0 and r["physics_only_realtime_factor"] > 0
         ratio = r["physics_only_realtime_factor"] / r["realtime_factor"]
         assert r["overhead_ratio"] == pytest.approx(ratio)
+
+
+def test_bench_runs_the_full_loop_with_grid_sensing(capsys):
+    assert main(["bench", "--robots", "4", "--seconds", "0.2", "--sensing", "grid", "--json"]) == 0
+    (result,) = json.loads(capsys.readouterr().out)["results"]
+    assert result["sensing"] == "grid" and result["robot_steps_per_s"] > 0
 
 
 @pytest.mark.parametrize(

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import itertools
 import math
+from fractions import Fraction
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 from mjswarm.errors import MjswarmError
 from mjswarm.radio import Radio, walls_blocker
@@ -39,6 +41,97 @@ def test_links_match_brute_force_distances(seed):
         if math.dist(xy[i], xy[j]) <= range_m
     }
     assert {frozenset(e) for e in radio.graph().edges} == expected
+
+
+
+def random_team(seed):
+    """Robot ids in a shuffled radio order, positions (m) and a range d_c (m).
+
+    Odd seeds put the robots on a lattice of pitch d_c/k: with a dyadic d_c (seed % 4 == 1)
+    many pairs are exactly d_c apart on an axis, the first two robots always; with d_c = 0.3
+    or 0.7 the lattice distances round either side of d_c. Every fifth seed gives two
+    robots a non-finite coordinate.
+    """
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(2, 201))
+    ids = rng.permutation(n).tolist()
+    if seed % 4 == 1:
+        range_m = float(rng.choice([0.25, 0.5, 1.0, 1.5]))
+    else:
+        range_m = float(rng.choice([0.3, 0.7, rng.uniform(0.05, 2.0)]))
+    if seed % 2:
+        xy = rng.integers(0, 12, (n, 2)) * (range_m / int(rng.choice([1, 2, 4])))
+        xy[1] = xy[0] + (range_m, 0.0)
+    else:
+        xy = rng.random((n, 2)) * rng.uniform(1.0, 10.0)
+    if seed % 5 == 0:
+        xy[rng.integers(2, n, 2) if n > 2 else 0] = [np.inf, np.nan][seed % 2]
+    return ids, dict(zip(ids, xy)), range_m
+
+
+def brute_force_links(positions, range_m, blocked=lambda i, j: False):
+    """O(N^2): the documented link rule, sum((p_i - p_j)**2) <= d_c**2, per pair."""
+    with np.errstate(invalid="ignore"):
+        return {
+            frozenset((i, j))
+            for i, j in itertools.combinations(positions, 2)
+            if ((positions[i] - positions[j]) ** 2).sum() <= range_m**2 and not blocked(i, j)
+        }
+
+
+@pytest.mark.parametrize("seed", range(60))
+def test_links_match_brute_force_with_boundaries_and_a_blocker(seed):
+    ids, positions, range_m = random_team(seed)
+    plain = Radio(ids, range_m=range_m)
+    plain.move(positions)
+    expected = brute_force_links(positions, range_m)
+    assert {frozenset(e) for e in plain.graph().edges} == expected
+    if seed % 4 == 1:  # exactly d_c apart on an axis: linked (inclusive range)
+        assert math.dist(positions[ids[0]], positions[ids[1]]) == range_m
+        assert ids[1] in plain.neighbors(ids[0])
+
+    def odd(pairs):  # by robot ids, so it depends on which pairs it is asked about
+        return np.array([(i + j) % 2 == 1 for i, j in pairs], dtype=bool)
+
+    cut = Radio(ids, range_m=range_m, blocked=odd)
+    cut.move(positions)
+    expected_cut = brute_force_links(positions, range_m, lambda i, j: (i + j) % 2 == 1)
+    assert {frozenset(e) for e in cut.graph().edges} == expected_cut
+    assert all(cut.neighbors(r) == {x for e in expected_cut if r in e for x in e} - {r}
+               for r in ids)
+
+
+
+def test_links_do_not_depend_on_the_k_d_trees_rounding(monkeypatch):
+    """The tree only proposes pairs; the exact squared-distance rule decides at d_c."""
+    class ShortTree(cKDTree):  # a tree whose own comparison loses pairs exactly at r
+        def query_pairs(self, r, *args, **kwargs):
+            return super().query_pairs(r * (1 - 1e-12), *args, **kwargs)
+
+    monkeypatch.setattr("mjswarm.radio.cKDTree", ShortTree)
+    for seed in range(1, 40, 4):  # the dyadic lattices of random_team
+        ids, positions, range_m = random_team(seed)
+        radio = Radio(ids, range_m=range_m)
+        radio.move(positions)
+        assert {frozenset(e) for e in radio.graph().edges} == brute_force_links(
+            positions, range_m
+        )
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_broadcast_recipients_are_in_radio_order(seed):
+    """Drops are drawn per copy in the radio's robot order (not id or insertion order)."""
+    ids, positions, range_m = random_team(seed)
+    drop_prob = 0.5
+    radio = Radio(ids, range_m=range_m, drop_prob=drop_prob, rng=seed)
+    radio.step(positions)
+    sender = max(ids, key=lambda r: len(radio.neighbors(r)))
+    radio.send(sender, "x")
+    radio.step()
+    got = {r for r in ids if radio.receive(r)}
+    reference = np.random.default_rng(seed)
+    in_order = [r for r in ids if r in radio.neighbors(sender)]
+    assert got == {r for r in in_order if not reference.random() < drop_prob}
 
 
 def test_delivery_after_exactly_one_tick():
@@ -134,9 +227,9 @@ def test_wall_touching_a_link_blocks_it_and_parallel_walls_do_not():
     touching = walls_blocker([((0.5, 0.0), (0.5, 1.0))], positions)
     parallel = walls_blocker([((0.0, 0.1), (1.0, 0.1))], positions)
     collinear_apart = walls_blocker([((2.0, 0.0), (3.0, 0.0))], positions)
-    assert touching("a", "b")
-    assert not parallel("a", "b")
-    assert not collinear_apart("a", "b")
+    assert touching([("a", "b")]).tolist() == [True]
+    assert parallel([("a", "b")]).tolist() == [False]
+    assert collinear_apart([("a", "b")]).tolist() == [False]
 
 
 @pytest.mark.parametrize("seed", range(10))
@@ -151,21 +244,81 @@ def test_walls_blocker_matches_parametric_intersection(seed):
         t, s = np.linalg.solve(m, np.subtract(c, p))
         return 0 <= t <= 1 and 0 <= s <= 1
 
-    for i, j in itertools.combinations(positions, 2):
-        expected = any(crosses(positions[i], positions[j], c, d) for c, d in walls)
-        assert blocked(i, j) == expected
+    pairs = list(itertools.combinations(positions, 2))
+    expected = [any(crosses(positions[i], positions[j], c, d) for c, d in walls) for i, j in pairs]
+    assert blocked(pairs).tolist() == expected
 
 
-def test_blocker_is_asked_only_for_pairs_in_range():
+
+def segments_meet(p, q, c, d):
+    """Scalar brute force in exact rationals: do closed segments p-q and c-d share a point?"""
+    p, q, c, d = (tuple(map(Fraction, x)) for x in (p, q, c, d))
+
+    def sub(u, v):
+        return (u[0] - v[0], u[1] - v[1])
+
+    def cross(u, v):
+        return u[0] * v[1] - u[1] * v[0]
+
+    r, s = sub(q, p), sub(d, c)
+    det = cross(r, s)
+    if det:  # one crossing point of the two lines: on both segments?
+        t, u = cross(sub(c, p), s) / det, cross(sub(c, p), r) / det
+        return 0 <= t <= 1 and 0 <= u <= 1
+    if r == (0, 0) and s == (0, 0):
+        return p == c
+    axis = r if r != (0, 0) else s  # parallel or degenerate: meet only if all collinear
+    base = p if r != (0, 0) else c
+    if any(cross(axis, sub(x, base)) for x in (p, q, c, d)):
+        return False
+
+    def along(x):
+        return x[0] * axis[0] + x[1] * axis[1]
+
+    lo1, hi1 = sorted((along(p), along(q)))
+    lo2, hi2 = sorted((along(c), along(d)))
+    return max(lo1, lo2) <= min(hi1, hi2)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_walls_blocker_matches_scalar_brute_force_including_touching(seed):
+    """Integer lattice coordinates make touching, collinear and degenerate cases common."""
+    rng = np.random.default_rng(seed)
+    grid = int(rng.integers(3, 7))
+    positions = {i: tuple(p) for i, p in enumerate(rng.integers(0, grid, (10, 2)).astype(float))}
+    walls = [tuple(map(tuple, rng.integers(0, grid, (2, 2)).astype(float)))
+             for _ in range(int(rng.integers(1, 6)))]
+    pairs = [tuple(rng.permutation(p).tolist())
+             for p in itertools.combinations(positions, 2)]
+    expected = [any(segments_meet(positions[i], positions[j], c, d) for c, d in walls)
+                for i, j in pairs]
+    assert walls_blocker(walls, positions)(pairs).tolist() == expected
+
+
+def test_walls_blocker_without_walls_or_pairs():
+    positions = {"a": (0.0, 0.0), "b": (1.0, 0.0)}
+    assert walls_blocker([], positions)([("a", "b")]).tolist() == [False]
+    assert walls_blocker([((0.5, -1.0), (0.5, 1.0))], positions)([]).shape == (0,)
+
+
+def test_blocker_is_asked_once_for_all_pairs_in_range_and_never_without_any():
     asked = []
 
-    def blocked(i, j):
-        asked.append(frozenset((i, j)))
-        return frozenset((i, j)) == {"r0", "r1"}
+    def blocked(pairs):
+        asked.append(list(pairs))
+        return np.array([{i, j} == {"r0", "r1"} for i, j in pairs])
 
     radio = line_radio([0.0, 0.5, 0.9, 5.0], blocked=blocked)
-    assert set(asked) == {frozenset(p) for p in [("r0", "r1"), ("r0", "r2"), ("r1", "r2")]}
+    assert asked == [[("r0", "r1"), ("r0", "r2"), ("r1", "r2")]]  # one call, robot order
     assert radio.neighbors("r0") == {"r2"}
+    radio.move({"r0": (0.0, 0.0), "r1": (2.0, 0.0), "r2": (4.0, 0.0), "r3": (6.0, 0.0)})
+    assert len(asked) == 1  # no pair in range: not called
+    assert radio.graph().number_of_edges() == 0
+
+
+def test_a_blocker_answering_the_wrong_shape_is_an_error():
+    with pytest.raises(MjswarmError, match="blocker returned shape"):
+        line_radio([0.0, 0.5, 0.9], blocked=lambda pairs: np.array(False))
 
 
 def test_explicit_edges_and_removal():
