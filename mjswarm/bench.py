@@ -109,6 +109,7 @@ def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROB
         raise MjswarmError(f"benchmark duration must be positive, got {sim_seconds} s")
     sim = bench_world(n, robot_xml, sensing)
     team = BenchTeam(sim)
+    team.tick()  # warm-up: one-time costs (loading the compiled ray loop) stay out of the timing
     ticks = max(1, round(sim_seconds / sim.control_dt_s))
     start = time.perf_counter()
     for _ in range(ticks):
