@@ -12,8 +12,12 @@ wall seconds) of three ways of stepping, all at the control rate of
 * ``tick_loop`` / ``tick_batch_tT`` (c): what an embodied run needs every tick. Each
   replicate's Python controller reads its own line sensors and writes new wheel
   commands (a proportional steer towards the side whose line rangefinder reads shorter),
-  then physics advances one tick exactly as :meth:`Simulation.step` does: sensors
-  disabled for the first k-1 substeps and enabled for the last. The loop toggles
+  then physics advances one tick as :meth:`Simulation.step` does with
+  ``sensing="mujoco"`` (its default below ``GRID_SENSING_MIN_ROBOTS`` = 32 robots):
+  sensors disabled for the first k-1 substeps and enabled for the last. (From 32 robots
+  Simulation casts the rangefinders itself, in Python/numba after a sensorless tick; the
+  batch analogue of that is (b) plus per-replicate ray casting the batch does not run,
+  so it is not measured here.) The loop toggles
   ``m.opt.disableflags``; the batch toggles its per-simulation copy
   (``expand('opt.disableflags')``), so it makes two ``step`` calls per tick
   (``nstep=k-1`` then ``nstep=1``) with the controllers' Python work between ticks.
@@ -30,7 +34,8 @@ Worlds: ``bench:N`` is :func:`mjswarm.bench.bench_world` with N robots; anything
 an arena (:func:`mjswarm.arena.load_arena`) with ``arena_robots`` robots placed by
 :func:`vertex_poses`.
 
-Result keys (:func:`bench`): ``world``, ``robots``, ``substeps``, ``ticks``,
+Result keys (:func:`bench`): ``world``, ``robots``, ``sensing`` (what
+:class:`Simulation` would use for this world; (c) always uses MuJoCo's), ``substeps``, ``ticks``,
 ``sim_seconds``, ``cpus``, ``threads``, ``mujoco``, ``load_average`` (the machine's 1, 5
 and 15 min load after the run: other work competes for the cores) and ``rows``, one per
 replicate count R with ``replicates``, ``rates`` (variant -> robot-s per wall s),
@@ -44,6 +49,7 @@ Run ``python benchmarks/batch_bench.py --help`` from the repository root.
 from __future__ import annotations
 
 import argparse
+import copy
 import json
 import os
 import sys
@@ -111,10 +117,15 @@ def _ids(m: mujoco.MjModel, obj: mujoco.mjtObj, n: int, names: Sequence[str]) ->
 
 
 class _Replicates:
-    """One world's model, replicate controls and controller, shared by all variants."""
+    """One world's model, replicate controls and controller, shared by all variants.
+
+    The model is a copy with MuJoCo's sensors enabled (a grid-sensing Simulation keeps
+    them disabled in its own model); each variant sets the sensor flag it needs.
+    """
 
     def __init__(self, sim: Simulation, replicates: int) -> None:
-        self.model, self.n, self.k = sim.model, sim.n, sim.substeps
+        self.model, self.n, self.k = copy.copy(sim.model), sim.n, sim.substeps
+        self.model.opt.disableflags &= ~SENSOR_BIT
         self.replicates = replicates
         ctrl = []
         for r in range(replicates):
@@ -172,12 +183,12 @@ class _Replicates:
                     m.opt.disableflags |= SENSOR_BIT
                     mujoco.mj_step(m, d, nstep=k - 1)
                     m.opt.disableflags &= ~SENSOR_BIT
-                mujoco.mj_step(m, d)
+                mujoco.mj_step(m, d)  # as Simulation.step with sensing="mujoco"
         return _clock() - start, datas
 
     def tick_batch(self, ticks: int, threads: int) -> tuple[np.ndarray, mujoco.batch.Batch]:
         b = mujoco.batch.Batch(self.model, nsim=self.replicates, nthread=threads)
-        flags = b.expand("opt.disableflags")
+        flags = b.expand("opt.disableflags")  # the batch's own copy; the model's is not read
         on, off = flags.copy(), flags | SENSOR_BIT
         b.forward()
         ctrl, sensordata = b.ctrl, b.sensordata  # live views: bind once
@@ -262,6 +273,7 @@ def bench(
     return {
         "world": world,
         "robots": sim.n,
+        "sensing": sim.sensing,
         "substeps": sim.substeps,
         "ticks": ticks,
         "sim_seconds": sim_seconds,

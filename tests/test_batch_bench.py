@@ -13,7 +13,7 @@ from mjswarm.errors import MjswarmError
 
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "batch_bench.py"
 ROW_KEYS = {"replicates", "rates", "speedups", "identical", "cores_busy"}
-TOP_KEYS = {"world", "robots", "substeps", "ticks", "sim_seconds", "cpus", "threads",
+TOP_KEYS = {"world", "robots", "sensing", "substeps", "ticks", "sim_seconds", "cpus", "threads",
             "mujoco", "load_average", "rows"}
 
 
@@ -25,9 +25,12 @@ def bench():
     return module
 
 
-def test_batch_matches_loop_bit_for_bit(bench):
-    r = bench.bench("arena2", replicates=[2], ticks=3, threads=[1, 2], repeats=1)
-    assert set(r) == TOP_KEYS and r["robots"] == 4 and r["substeps"] == 10
+@pytest.mark.parametrize("world, robots, sensing", [("arena2", 4, "mujoco"), ("bench:33", 33, "grid")])
+def test_batch_matches_loop_bit_for_bit(bench, world, robots, sensing):
+    """Also on a grid-sensing world, whose Simulation keeps MuJoCo's sensors disabled."""
+    r = bench.bench(world, replicates=[2], ticks=3, threads=[1, 2], repeats=1)
+    assert set(r) == TOP_KEYS and r["substeps"] == 10
+    assert (r["robots"], r["sensing"]) == (robots, sensing)
     (row,) = r["rows"]
     assert set(row) == ROW_KEYS and row["replicates"] == 2
     variants = {"batch_t1", "batch_t2", "tick_batch_t1", "tick_batch_t2"}
