@@ -22,7 +22,7 @@ import numpy as np
 
 from algorithms.connectivity.tables import ConnectivityTable
 from mjswarm.bearing import line_of_sight
-from mjswarm.radio import Radio
+from mjswarm.radio import Blocker, Radio
 from mjswarm.simulation import Simulation
 
 #: where robots that are not on the arena are, for the radio (m): out of everyone's range
@@ -45,9 +45,8 @@ class TableAwareness:
                  line_of_sight: bool = True) -> None:
         self.sim = sim
         self.reference = reference
-        blocked = ((lambda pairs: ~mutual_sight(sim, *np.asarray(pairs, np.int64).reshape(-1, 2).T))
-                   if line_of_sight else None)
-        self.radio = Radio(range(sim.n), range_m=range_m, blocked=blocked)
+        self.radio = Radio(range(sim.n), range_m=range_m,
+                           blocked=sight_blocker(sim) if line_of_sight else None)
         self.tables = {i: ConnectivityTable(i, reference) for i in range(sim.n)}
         self.now = 0
         self.agree = 0
@@ -90,6 +89,12 @@ class TableAwareness:
         return self.agree / self.samples if self.samples else None
 
 
-def mutual_sight(sim: Simulation, i: np.ndarray, j: np.ndarray) -> np.ndarray:
-    """Per pair: each robot of the pair sees the other (a link needs both directions)."""
-    return line_of_sight(sim, i, j) & line_of_sight(sim, j, i)
+def sight_blocker(sim: Simulation) -> Blocker:
+    """The radio's line-of-sight test on a simulation: a link between robots i and j is
+    blocked unless each sees the other (:func:`mjswarm.bearing.line_of_sight` both ways)."""
+
+    def blocked(pairs: list[tuple[int, int]]) -> np.ndarray:
+        i, j = np.asarray(pairs, np.int64).reshape(-1, 2).T
+        return ~(line_of_sight(sim, i, j) & line_of_sight(sim, j, i))
+
+    return blocked

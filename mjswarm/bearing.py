@@ -83,6 +83,6 @@ def line_of_sight(sim: Simulation, k: np.ndarray, p: np.ndarray,
     unit = np.column_stack([vec / np.where(apart, dist, 1.0)[:, None], np.zeros(len(k))])
     unit[~apart, 0] = 1.0  # coincident robots: any direction, the answer is "no"
     start = np.column_stack([poses[k, :2], np.full(len(k), RAY_HEIGHT_M)])
-    rays = Rays(start, unit, dist + sim.rays.robot_radius_m, k, sim.robot_bodies[k])
+    rays = Rays(start, unit, dist + sim.rays.robot_radius_m, sim.robot_bodies[k])
     _, geom = sim.rays.cast(rays, _GROUP0)
     return apart & (geom >= 0) & (sim.geom_robot[geom] == p)

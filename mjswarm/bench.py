@@ -26,7 +26,7 @@ import mujoco
 import numpy as np
 
 from algorithms.collision import CollisionRule, epsilons
-from mjswarm.awareness import mutual_sight
+from mjswarm.awareness import sight_blocker
 from mjswarm.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
 from mjswarm.radio import Radio
@@ -75,8 +75,7 @@ class BenchTeam:
     def __init__(self, sim: Simulation) -> None:
         self.sim = sim
         self.bearing = BearingSensor(sim)
-        self.radio = Radio(range(sim.n), range_m=RADIO_RANGE_M,
-                           blocked=lambda pairs: ~mutual_sight(sim, *np.asarray(pairs).reshape(-1, 2).T))
+        self.radio = Radio(range(sim.n), range_m=RADIO_RANGE_M, blocked=sight_blocker(sim))
         self.rules = [CollisionRule(BENCH_SPEED_M_S, e, dt=sim.control_dt_s) for e in epsilons(sim.n)]
         self.heard = 0
 

@@ -53,14 +53,12 @@ class Rays:
         direction: (M, 3) directions; distances are in units of their length (unit vectors
             give metres).
         length: (M,) how far along each ray a hit matters (units of ``direction``).
-        robot: (M,) index of the robot each ray starts from (its reach is measured from it).
         exclude_body: (M,) body id whose geoms the ray ignores (``mj_ray``'s ``bodyexclude``).
     """
 
     origin: np.ndarray
     direction: np.ndarray
     length: np.ndarray
-    robot: np.ndarray
     exclude_body: np.ndarray
 
 

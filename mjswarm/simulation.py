@@ -14,7 +14,7 @@ Sensing comes in two interchangeable implementations (``sensing=``; the default
 ``"auto"`` takes ``"mujoco"`` below ``GRID_SENSING_MIN_ROBOTS`` robots, where its O(N^2)
 costs less than the grid's fixed per-tick cost, and ``"grid"`` from there on):
 
-* ``"grid"`` (default), O(N): MuJoCo's sensor stage stays disabled; the rangefinders
+* ``"grid"``, O(N): MuJoCo's sensor stage stays disabled; the rangefinders
   declared in the robot model (site, direction = site z axis, ``cutoff``) are cast by
   :class:`mjswarm.raycast.RayCaster` against nearby geoms only, and encoders and wheel
   speeds are the wheel joints' ``qpos`` / ``qvel``, which is what MuJoCo's ``jointpos`` /
@@ -238,7 +238,8 @@ class Simulation:
                 mujoco.mj_step(m, d, nstep=self.substeps - 1)
                 if self.sensing == "mujoco":
                     m.opt.disableflags &= ~sensor_bit
-            self._wheels = self._wheel_state()  # the state the last step's sensors see
+            if self.sensing == "grid":
+                self._wheels = self._wheel_state()  # the state the last step's sensors see
             mujoco.mj_step(m, d)
             self.step_count += 1
             self.battery.update(d.actuator_force[self._actuators], self.control_dt_s)
@@ -262,9 +263,7 @@ class Simulation:
         else:
             site = m.sensor_objid[self._range_ids].ravel()
             length = np.where(cutoff > 0, cutoff, UNBOUNDED_PROBE_M).ravel()
-            robot = np.repeat(np.arange(self.n), self._range_ids.shape[1])
-            rays = Rays(d.site_xpos[site], d.site_xmat[site][:, 2::3].copy(), length, robot,
-                        m.site_bodyid[site])
+            rays = Rays(d.site_xpos[site], d.site_xmat[site][:, 2::3].copy(), length, m.site_bodyid[site])
             dist, _ = self.rays.cast(rays)
             for k in np.flatnonzero((dist < 0) & (cutoff.ravel() <= 0)):
                 dist[k] = mujoco.mj_ray(m, d, rays.origin[k], rays.direction[k], None, 1,

@@ -120,7 +120,7 @@ def test_ray_caster_equals_mj_ray(seed):
     origin = d.xpos[grid.robot_bodies][robot] + rng.normal(0.0, 0.08, (count, 3))
     direction = rng.normal(size=(count, 3))
     direction *= rng.uniform(0.2, 3.0, (count, 1)) / np.linalg.norm(direction, axis=1, keepdims=True)
-    rays = Rays(origin, direction, rng.uniform(0.0, 1.5, count), robot, grid.robot_bodies[robot])
+    rays = Rays(origin, direction, rng.uniform(0.0, 1.5, count), grid.robot_bodies[robot])
     geomid = np.zeros(1, np.int32)
     for group in (None, np.array([1, 0, 0, 0, 0, 0], np.uint8)):
         dist, geom = grid.rays.cast(rays, group)
