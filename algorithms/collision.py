@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import operator
 from collections import deque
 from dataclasses import dataclass, field
 
@@ -110,7 +111,7 @@ class CollisionRule:
         samples = self._history.get(p)
         if samples is None or len(samples) < self.window:
             return None
-        return sum(w * b for w, b in zip(self._slope_weights, samples))
+        return math.fsum(map(operator.mul, self._slope_weights, samples))
 
     def update(self, bearings: dict[int, float]) -> float:
         """Take this tick's bearings ``{p: beta_kp}`` (rad) and return ``S_k`` (m/s)."""

@@ -2,7 +2,7 @@
 
 With ``--radio-range R`` an embodied run gives every robot a radio (:class:`mjswarm.radio.
 Radio`: range ``R``, one control tick of latency, links blocked by walls through
-:func:`mjswarm.bearing.line_of_sight`, vectorised over pairs) and a connectivity table of internally disjoint
+:attr:`mjswarm.simulation.Simulation.sight`, vectorised over pairs) and a connectivity table of internally disjoint
 access paths to the reference robot R1 (seed 004, :class:`algorithms.connectivity.tables.
 ConnectivityTable`), updated every control tick as links appear (table exchange) and break
 (Link-Broken) while the robots move.
@@ -21,7 +21,6 @@ import networkx as nx
 import numpy as np
 
 from algorithms.connectivity.tables import ConnectivityTable
-from mjswarm.bearing import line_of_sight
 from mjswarm.radio import Blocker, Radio
 from mjswarm.simulation import Simulation
 
@@ -91,10 +90,11 @@ class TableAwareness:
 
 def sight_blocker(sim: Simulation) -> Blocker:
     """The radio's line-of-sight test on a simulation: a link between robots i and j is
-    blocked unless each sees the other (:func:`mjswarm.bearing.line_of_sight` both ways)."""
+    blocked unless each sees the other (:attr:`Simulation.sight` both ways)."""
 
-    def blocked(pairs: list[tuple[int, int]]) -> np.ndarray:
+    def blocked(pairs: np.ndarray) -> np.ndarray:
         i, j = np.asarray(pairs, np.int64).reshape(-1, 2).T
-        return ~(line_of_sight(sim, i, j) & line_of_sight(sim, j, i))
+        seen = sim.sight(np.concatenate([i, j]), np.concatenate([j, i]))
+        return ~(seen[: len(i)] & seen[len(i):])
 
     return blocked

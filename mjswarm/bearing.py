@@ -3,15 +3,15 @@
 Modelled on an omnidirectional IR beacon receiver with robot identification (each
 robot's beacon is modulated with its id): robot ``k`` sees robot ``p`` when ``p`` is within
 ``range_m`` and inside the field of view ``|beta| <= fov_rad`` around ``k``'s heading, and
-nothing blocks the line of sight (a ray from ``k``'s centre, at ``RAY_HEIGHT_M``, towards
+nothing blocks the line of sight (:mod:`mjswarm.sight`: a ray from ``k``'s centre towards
 ``p`` hits ``p`` first; only collision geoms, group 0, block: walls and robots).
 The reading is ``beta_kp``: the angle from ``k``'s heading to ``p`` (rad, CCW positive),
 plus optional Gaussian noise. Defaults: +-60 degrees, 1 m.
 
 Sampled at the control rate from the simulated world; controllers receive only
 ``{p: beta_kp}``. O(N) for bounded density: candidate pairs come from a k-d tree of the
-robots' positions (``cKDTree.query_pairs``), and the line-of-sight rays are cast by the
-simulation's :class:`~mjswarm.raycast.RayCaster`, which answers as ``mj_ray`` does.
+robots' positions (``cKDTree.query_pairs``), and line of sight is the simulation's
+:attr:`~mjswarm.simulation.Simulation.sight`, cast once per state and shared with the radio.
 """
 
 from __future__ import annotations
@@ -21,10 +21,8 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from mjswarm.raycast import Rays
 from mjswarm.simulation import Simulation
 
-RAY_HEIGHT_M = 0.06  # above the wheels (0.05 m), inside the chassis (0.012..0.07 m)
 DEFAULT_FOV_RAD = math.radians(60.0)
 DEFAULT_RANGE_M = 1.0
 
@@ -41,10 +39,10 @@ class BearingSensor:
         self.fov_rad, self.range_m, self.noise_rad = fov_rad, range_m, noise_rad
         self.rng = np.random.default_rng(seed)
 
-    def read(self, poses: np.ndarray | None = None) -> list[dict[int, float]]:
+    def read(self) -> list[dict[int, float]]:
         """For every robot ``k``: ``{p: beta_kp}`` (rad) of the robots it sees now."""
         sim = self.sim
-        poses = sim.poses() if poses is None else poses
+        poses = sim.poses()
         n = len(poses)
         pairs = cKDTree(poses[:, :2]).query_pairs(self.range_m, output_type="ndarray")
         k = np.concatenate([pairs[:, 0], pairs[:, 1]])
@@ -54,7 +52,7 @@ class BearingSensor:
         beta = np.arctan2(np.sin(beta), np.cos(beta))
         ahead = np.abs(beta) <= self.fov_rad
         k, p, beta = k[ahead], p[ahead], beta[ahead]
-        seen = line_of_sight(sim, k, p, poses)
+        seen = sim.sight(k, p)
         k, p, beta = k[seen], p[seen], beta[seen]
         order = np.lexsort((p, k))
         k, p, beta = k[order], p[order], beta[order]
@@ -64,25 +62,3 @@ class BearingSensor:
         for ki, pi, b in zip(k.tolist(), p.tolist(), beta.tolist()):
             out[ki][pi] = b
         return out
-
-
-_GROUP0 = np.array([1, 0, 0, 0, 0, 0], dtype=np.uint8)
-
-
-def line_of_sight(sim: Simulation, k: np.ndarray, p: np.ndarray,
-                  poses: np.ndarray | None = None) -> np.ndarray:
-    """For every pair ``(k[i], p[i])``: whether robot ``p`` is the first thing a ray from
-    robot ``k``'s centre towards it hits (collision geoms only, at RAY_HEIGHT_M): walls and
-    other robots block. Every geom of ``p`` lies within ``R`` of its centre, so a ray of
-    length ``|p - k| + R`` finds ``p`` if ``mj_ray`` would."""
-    poses = sim.poses() if poses is None else poses
-    k, p = np.asarray(k, np.int64), np.asarray(p, np.int64)
-    vec = poses[p, :2] - poses[k, :2]
-    dist = np.hypot(vec[:, 0], vec[:, 1])
-    apart = dist > 0
-    unit = np.column_stack([vec / np.where(apart, dist, 1.0)[:, None], np.zeros(len(k))])
-    unit[~apart, 0] = 1.0  # coincident robots: any direction, the answer is "no"
-    start = np.column_stack([poses[k, :2], np.full(len(k), RAY_HEIGHT_M)])
-    rays = Rays(start, unit, dist + sim.rays.robot_radius_m, sim.robot_bodies[k])
-    _, geom = sim.rays.cast(rays, _GROUP0)
-    return apart & (geom >= 0) & (sim.geom_robot[geom] == p)

@@ -82,12 +82,11 @@ class BenchTeam:
     def tick(self) -> None:
         """Sense, communicate, decide and command every robot, then step the world once."""
         sim = self.sim
-        poses = sim.poses()
-        self.radio.step(dict(enumerate(poses[:, :2])))
+        self.radio.step(dict(enumerate(sim.poses()[:, :2])))
         for i in range(sim.n):
             self.heard += len(self.radio.receive(i))
             self.radio.send(i, sim.step_count)
-        bearings = self.bearing.read(poses)
+        bearings = self.bearing.read()
         speed = np.array([rule.update(seen) for rule, seen in zip(self.rules, bearings)])
         sim.set_velocity(speed, line_following_turn(sim))
         sim.step()

@@ -52,9 +52,10 @@ from scipy.spatial import cKDTree
 
 from mjswarm.errors import MjswarmError
 
-#: ``blocked(pairs) -> mask``: for a list of robot-id pairs ``(i, j)``, a bool array with one
-#: entry per pair, True when i and j cannot hear each other (no line of sight).
-Blocker = Callable[[list[tuple[Hashable, Hashable]]], np.ndarray]
+#: ``blocked(pairs) -> mask``: for an (M, 2) array of robot-id pairs ``(i, j)`` (int64 when
+#: every id is an int, else objects), a bool array with one entry per pair, True when i and
+#: j cannot hear each other (no line of sight).
+Blocker = Callable[[np.ndarray], np.ndarray]
 
 #: relative enlargement of the k-d tree's search radius over d_c (the exact test decides)
 _CANDIDATE_SLACK = 1e-9
@@ -94,6 +95,12 @@ class Radio:
     ) -> None:
         self.robots: tuple[Hashable, ...] = tuple(robots)
         self._index: dict[Hashable, int] = {r: k for k, r in enumerate(self.robots)}
+        if all(isinstance(r, (int, np.integer)) for r in self.robots):
+            self._ids = np.array(self.robots, dtype=np.int64)
+        else:
+            self._ids = np.empty(len(self.robots), dtype=object)
+            for k, r in enumerate(self.robots):
+                self._ids[k] = r
         if len(self._index) != len(self.robots):
             raise MjswarmError("radio: duplicate robot ids")
         if (range_m is None) == (edges is None):
@@ -250,10 +257,7 @@ class Radio:
         ij = rows[near]  # k < l: query_pairs gives i < j and ``rows`` increases
         ij = ij[np.lexsort((ij[:, 1], ij[:, 0]))]
         if self.blocked is not None and len(ij):
-            cut = np.asarray(
-                self.blocked([(self.robots[k], self.robots[m]) for k, m in ij.tolist()]),
-                dtype=bool,
-            )
+            cut = np.asarray(self.blocked(self._ids[ij]), dtype=bool)
             if cut.shape != (len(ij),):
                 raise MjswarmError(
                     f"radio: the blocker returned shape {cut.shape} for {len(ij)} pairs"
@@ -302,8 +306,8 @@ def walls_blocker(
             q[..., 1] <= np.maximum(o[..., 1], p[..., 1])
         )
 
-    def blocked(pairs: list[tuple[Hashable, Hashable]]) -> np.ndarray:
-        if not len(w) or not pairs:
+    def blocked(pairs: np.ndarray) -> np.ndarray:
+        if not len(w) or not len(pairs):
             return np.zeros(len(pairs), dtype=bool)
         ends = np.array(
             [(positions[i][:2], positions[j][:2]) for i, j in pairs], dtype=float

@@ -6,7 +6,9 @@ about 6.7 ns per ray x geom pair, so N robots casting a few rays each cost O(N^2
 nearest hit within ``L`` and its geom), testing each ray only against
 
 * geoms welded to the world, binned once into a uniform 2-D grid of ``cell_m`` cells by
-  their world bounding boxes (planes, unbounded, are always tested);
+  their world bounding boxes (planes, unbounded, are always tested); a geom spanning
+  several cells of a ray's box is tested once, and only if the segment meets its world
+  bounding box (grown by 1 um);
 * the geoms of robots binned, at every cast, by their centres into the same grid: robot
   j's geoms lie within ``R`` of its centre, so only robots in the cells of the ray's
   segment box grown by ``R`` can be hit, and of those only robots whose centre is within
@@ -19,8 +21,10 @@ line-by-line transcription of MuJoCo's ``mju_rayGeom`` (``engine_ray.c``: ``ray_
 ``ray_sphere``, ``ray_box``, ``ray_cylinder`` with their bounding-sphere tests and the
 ``mjMINVAL`` guards), with ``mj_ray``'s elimination rules (the excluded body, invisible
 geoms by ``rgba`` or material alpha, geom groups). Ties go to the lower geom id, as in
-``mj_ray``. The per-ray loop is compiled with numba. ``tests/test_raycast.py`` checks distances within 1e-9 and geom ids against
-``mj_ray`` on random states.
+``mj_ray``. The per-ray loop is compiled with numba and runs the rays in parallel
+(``prange``, one thread per core unless ``NUMBA_NUM_THREADS`` says otherwise).
+``tests/test_raycast.py`` checks distances within 1e-9 and geom ids against ``mj_ray`` on
+random states.
 
 Supported geom types are plane, sphere, box and cylinder (every geom of mjswarm's robots
 and arenas); a model with another ray-visible type raises :class:`MjswarmError` naming it,
@@ -33,7 +37,7 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from mjswarm.errors import MjswarmError
 
@@ -118,7 +122,15 @@ class RayCaster:
         self._origin = np.minimum(lo.min(axis=0, initial=np.inf), robots.min(axis=0))
         top = np.maximum(hi.max(axis=0, initial=-np.inf), robots.max(axis=0))
         self._shape = tuple(int(k) for k in np.floor((top - self._origin) / cell_m) + 1)
-        cells, owner = self._expand(self._cells(lo), self._cells(hi))
+        lo_cell = self._cells(lo)
+        cells, owner = self._expand(lo_cell, self._cells(hi))
+        # per static geom: its first cell, and its world AABB grown by 1 um (a hit lies on
+        # the geom, so inside the box up to rounding; growing keeps the box test safe)
+        self._static_corner = np.zeros((m.ngeom, 2), np.int64)
+        self._static_corner[geoms] = lo_cell
+        grow = 1e-6 + 1e-9 * np.abs(centre) + 1e-9 * half
+        self._static_box = np.zeros((m.ngeom, 6))
+        self._static_box[geoms] = np.hstack([centre - half - grow, centre + half + grow])
         order = np.argsort(cells, kind="stable")
         self._cell_geoms = geoms[owner[order]].astype(np.int64)
         self._cell_start = np.searchsorted(cells[order], np.arange(self._shape[0] * self._shape[1] + 1))
@@ -143,10 +155,12 @@ class RayCaster:
         """Nearest hit of every ray within its length: (distance, geom id), -1 where none.
 
         ``geomgroup`` is ``mj_ray``'s: None tests every group, else a 0/1 flag per group.
-        Static geoms are always tested (``mj_ray``'s ``flg_static = 1``).
+        Static geoms are always tested (``mj_ray``'s ``flg_static = 1``). Rays are cast in
+        parallel on numba's threads (one per core by default; ``numba.set_num_threads``).
         """
         m, d = self.model, self.data
         groups = np.ones(mujoco.mjNGROUP, bool) if geomgroup is None else np.asarray(geomgroup, bool)
+        candidate = self.visible & groups[self.group]
         centres = d.xpos[self.robot_bodies]
         cells = self._flat(self._cells(centres[:, :2]))
         order = np.argsort(cells, kind="stable")
@@ -154,11 +168,11 @@ class RayCaster:
         n = len(rays.length)
         dist, geom = np.full(n, -1.0), np.full(n, -1, np.int64)
         _cast(np.ascontiguousarray(rays.origin, float), np.ascontiguousarray(rays.direction, float),
-              np.asarray(rays.length, float), np.asarray(rays.exclude_body, np.int64), groups,
-              m.geom_type, m.geom_bodyid, self.group, self.visible, d.geom_xpos, d.geom_xmat,
-              m.geom_size, m.geom_rbound, self.always,
-              self._origin, self.cell_m, np.array(self._shape, np.int64),
-              self._cell_start, self._cell_geoms, robot_start, order.astype(np.int64), centres,
+              np.asarray(rays.length, float), np.asarray(rays.exclude_body, np.int64), candidate,
+              m.geom_type, m.geom_bodyid, d.geom_xpos, d.geom_xmat, m.geom_size, m.geom_rbound,
+              self.always, self._origin, self.cell_m, np.array(self._shape, np.int64),
+              self._cell_start, self._cell_geoms, self._static_box, self._static_corner,
+              robot_start, order.astype(np.int64), centres,
               self._robot_geom_start, self._robot_geoms, self.robot_radius_m, dist, geom)
         return dist, geom
 
@@ -167,31 +181,42 @@ class RayCaster:
 
 
 # ----------------------------------------------------------------- the compiled ray loop
-@njit(cache=True)
-def _cast(origin, direction, length, exclude_body, groups, geom_type, geom_bodyid, geom_group,
-          visible, geom_xpos, geom_xmat, geom_size, geom_rbound, always, grid_origin, cell_m,
-          shape, cell_start, cell_geoms, robot_start, robots, centres, robot_geom_start,
+@njit(cache=True, parallel=True)
+def _cast(origin, direction, length, exclude_body, candidate, geom_type, geom_bodyid, geom_xpos,
+          geom_xmat, geom_size, geom_rbound, always, grid_origin, cell_m, shape, cell_start,
+          cell_geoms, static_box, static_corner, robot_start, robots, centres, robot_geom_start,
           robot_geoms, robot_radius, out_dist, out_geom):  # pragma: no cover (compiled)
-    for r in range(len(length)):
-        pnt, vec, top = origin[r], direction[r], length[r]
+    """Every ray's nearest hit (``out_dist``, ``out_geom``); rays in parallel (``prange``).
+
+    A static geom spanning several cells of the ray's box is tested once, in the first of
+    them (its ``static_corner`` clipped to the box), and only if the segment meets its
+    world AABB (``static_box``)."""
+    for r in prange(len(length)):
+        # scalars and tuples, not array views: a view costs a reference count per use
+        pnt = (origin[r, 0], origin[r, 1], origin[r, 2])
+        vec = (direction[r, 0], direction[r, 1], direction[r, 2])
+        top, skip = length[r], exclude_body[r]
         best, best_geom = -1.0, -1
         end0, end1 = pnt[0] + top * vec[0], pnt[1] + top * vec[1]
         lo0, hi0 = min(pnt[0], end0), max(pnt[0], end0)
         lo1, hi1 = min(pnt[1], end1), max(pnt[1], end1)
         for g in always:
-            best, best_geom = _try(g, r, best, best_geom, pnt, vec, top, exclude_body, groups,
-                                   geom_type, geom_bodyid, geom_group, visible, geom_xpos,
-                                   geom_xmat, geom_size, geom_rbound)
+            best, best_geom = _try(g, best, best_geom, pnt, vec, top, skip, candidate, geom_type,
+                                   geom_bodyid, geom_xpos, geom_xmat, geom_size, geom_rbound)
         cx0, cy0 = _cell(lo0, lo1, grid_origin, cell_m, shape)
         cx1, cy1 = _cell(hi0, hi1, grid_origin, cell_m, shape)
         for cx in range(cx0, cx1 + 1):
             for cy in range(cy0, cy1 + 1):
                 c = cx * shape[1] + cy
                 for k in range(cell_start[c], cell_start[c + 1]):
-                    best, best_geom = _try(cell_geoms[k], r, best, best_geom, pnt, vec, top,
-                                           exclude_body, groups, geom_type, geom_bodyid,
-                                           geom_group, visible, geom_xpos, geom_xmat, geom_size,
-                                           geom_rbound)
+                    g = cell_geoms[k]
+                    if (not candidate[g] or max(static_corner[g, 0], cx0) != cx
+                            or max(static_corner[g, 1], cy0) != cy
+                            or not _meets_box(static_box, g, pnt, vec, top)):
+                        continue
+                    best, best_geom = _try(g, best, best_geom, pnt, vec, top, skip, candidate,
+                                           geom_type, geom_bodyid, geom_xpos, geom_xmat,
+                                           geom_size, geom_rbound)
         cx0, cy0 = _cell(lo0 - robot_radius, lo1 - robot_radius, grid_origin, cell_m, shape)
         cx1, cy1 = _cell(hi0 + robot_radius, hi1 + robot_radius, grid_origin, cell_m, shape)
         for cx in range(cx0, cx1 + 1):
@@ -199,13 +224,13 @@ def _cast(origin, direction, length, exclude_body, groups, geom_type, geom_bodyi
                 c = cx * shape[1] + cy
                 for k in range(robot_start[c], robot_start[c + 1]):
                     i = robots[k]
-                    if _gap_sq(centres[i], pnt, vec, top) > robot_radius * robot_radius * (1 + 1e-9):
+                    centre = (centres[i, 0], centres[i, 1], centres[i, 2])
+                    if _gap_sq(centre, pnt, vec, top) > robot_radius * robot_radius * (1 + 1e-9):
                         continue
                     for j in range(robot_geom_start[i], robot_geom_start[i + 1]):
-                        best, best_geom = _try(robot_geoms[j], r, best, best_geom, pnt, vec, top,
-                                               exclude_body, groups, geom_type, geom_bodyid,
-                                               geom_group, visible, geom_xpos, geom_xmat,
-                                               geom_size, geom_rbound)
+                        best, best_geom = _try(robot_geoms[j], best, best_geom, pnt, vec, top,
+                                               skip, candidate, geom_type, geom_bodyid,
+                                               geom_xpos, geom_xmat, geom_size, geom_rbound)
         out_dist[r], out_geom[r] = best, best_geom
 
 
@@ -227,15 +252,35 @@ def _gap_sq(point, pnt, vec, top):  # pragma: no cover (compiled)
 
 
 @njit(cache=True)
-def _try(g, r, best, best_geom, pnt, vec, top, exclude_body, groups, geom_type, geom_bodyid,
-         geom_group, visible, geom_xpos, geom_xmat, geom_size, geom_rbound):  # pragma: no cover
+def _meets_box(box, g, pnt, vec, top):  # pragma: no cover (compiled)
+    """Whether the segment ``pnt + t vec``, ``0 <= t <= top``, meets geom ``g``'s box
+    ``box[g, :3] <= x <= box[g, 3:]`` (slab test)."""
+    t0, t1 = 0.0, top
+    for a in range(3):
+        if vec[a] == 0.0:
+            if pnt[a] < box[g, a] or pnt[a] > box[g, a + 3]:
+                return False
+            continue
+        s0, s1 = (box[g, a] - pnt[a]) / vec[a], (box[g, a + 3] - pnt[a]) / vec[a]
+        t0, t1 = max(t0, min(s0, s1)), min(t1, max(s0, s1))
+        if t0 > t1:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _try(g, best, best_geom, pnt, vec, top, skip, candidate, geom_type, geom_bodyid, geom_xpos,
+         geom_xmat, geom_size, geom_rbound):  # pragma: no cover (compiled)
     """mj_ray's elimination, the segment test, mju_rayGeom, and the nearest-hit update."""
-    if not visible[g] or geom_bodyid[g] == exclude_body[r] or not groups[geom_group[g]]:
+    if not candidate[g] or geom_bodyid[g] == skip:
         return best, best_geom
     kind = geom_type[g]
-    if kind != PLANE and _gap_sq(geom_xpos[g], pnt, vec, top) > geom_rbound[g] * geom_rbound[g] * (1 + 1e-9):
+    pos = (geom_xpos[g, 0], geom_xpos[g, 1], geom_xpos[g, 2])
+    if kind != PLANE and _gap_sq(pos, pnt, vec, top) > geom_rbound[g] * geom_rbound[g] * (1 + 1e-9):
         return best, best_geom
-    x = _ray_geom(kind, geom_xpos[g], geom_xmat[g], geom_size[g], pnt, vec)
+    mat = (geom_xmat[g, 0], geom_xmat[g, 1], geom_xmat[g, 2], geom_xmat[g, 3], geom_xmat[g, 4],
+           geom_xmat[g, 5], geom_xmat[g, 6], geom_xmat[g, 7], geom_xmat[g, 8])
+    x = _ray_geom(kind, pos, mat, (geom_size[g, 0], geom_size[g, 1], geom_size[g, 2]), pnt, vec)
     if x >= 0 and x <= top and (best < 0 or x < best or (x == best and g < best_geom)):
         return x, g
     return best, best_geom

@@ -48,6 +48,7 @@ from mjswarm.robot import (
     WHEEL_SPEED_SENSORS,
     measure_geometry,
 )
+from mjswarm.sight import LineOfSight
 from mjswarm.world import Pose2D, yaw_quat
 
 #: One robot's sensor record: line rangefinders (m), IR distances (m, NaN = nothing
@@ -127,6 +128,9 @@ class Simulation:
         self._actuators = ids(mujoco.mjtObj.mjOBJ_ACTUATOR, ACTUATORS)
         self._range_ids = ids(sens, LINE_SENSORS + IR_SENSORS)  # (N, 6): line, then IR
         self._range_adr = m.sensor_adr[self._range_ids]
+        self._range_cutoff = m.sensor_cutoff[self._range_ids]
+        self._range_site = m.sensor_objid[self._range_ids].ravel()
+        self._range_length = np.where(self._range_cutoff > 0, self._range_cutoff, UNBOUNDED_PROBE_M).ravel()
         self._enc_adr = m.sensor_adr[ids(sens, ENCODERS)]
         self._vel_adr = m.sensor_adr[ids(sens, WHEEL_SPEED_SENSORS)]
         wheel_joints = m.sensor_objid[ids(sens, ENCODERS)]
@@ -148,6 +152,9 @@ class Simulation:
         self.collisions = CollisionCounter(geom_robot)
         self.battery = Battery(self.n)
         self.step_count = 0
+        #: changes whenever the world's state does (a step, or the experimenter's hand)
+        self.state_version = 0
+        self._sight: LineOfSight | None = None
         if sensing == "grid":
             m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
             mujoco.mj_kinematics(m, self.data)
@@ -162,6 +169,13 @@ class Simulation:
         if self._rays is None:
             self._rays = RayCaster(self.model, self.data, self.robot_bodies, self.geom_robot)
         return self._rays
+
+    @property
+    def sight(self) -> LineOfSight:
+        """Robot-to-robot line of sight, cast once per state (:mod:`mjswarm.sight`)."""
+        if self._sight is None:
+            self._sight = LineOfSight(self)
+        return self._sight
 
     def _subtree(self, root: int) -> np.ndarray:
         """Body ids of ``root`` and all its descendants."""
@@ -224,6 +238,7 @@ class Simulation:
     def _sense_now(self) -> None:
         """Recompute kinematics (and MuJoCo's sensors, if on) and read every sensor."""
         mujoco.mj_forward(self.model, self.data)
+        self.state_version += 1
         self._wheels = self._wheel_state()
         self._readings = self._read_sensors()
 
@@ -242,6 +257,7 @@ class Simulation:
                 self._wheels = self._wheel_state()  # the state the last step's sensors see
             mujoco.mj_step(m, d)
             self.step_count += 1
+            self.state_version += 1
             self.battery.update(d.actuator_force[self._actuators], self.control_dt_s)
             self.collisions.update(d)
             self._readings = self._read_sensors()
@@ -257,13 +273,12 @@ class Simulation:
         -cutoff after its clamp).
         """
         m, d = self.model, self.data
-        cutoff = m.sensor_cutoff[self._range_ids]
+        cutoff = self._range_cutoff
         if self.sensing == "mujoco":
             raw = d.sensordata[self._range_adr]
         else:
-            site = m.sensor_objid[self._range_ids].ravel()
-            length = np.where(cutoff > 0, cutoff, UNBOUNDED_PROBE_M).ravel()
-            rays = Rays(d.site_xpos[site], d.site_xmat[site][:, 2::3].copy(), length, m.site_bodyid[site])
+            site = self._range_site
+            rays = Rays(d.site_xpos[site], d.site_xmat[site][:, 2::3], self._range_length, m.site_bodyid[site])
             dist, _ = self.rays.cast(rays)
             for k in np.flatnonzero((dist < 0) & (cutoff.ravel() <= 0)):
                 dist[k] = mujoco.mj_ray(m, d, rays.origin[k], rays.direction[k], None, 1,

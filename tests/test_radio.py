@@ -305,7 +305,7 @@ def test_blocker_is_asked_once_for_all_pairs_in_range_and_never_without_any():
     asked = []
 
     def blocked(pairs):
-        asked.append(list(pairs))
+        asked.append([tuple(p) for p in pairs])
         return np.array([{i, j} == {"r0", "r1"} for i, j in pairs])
 
     radio = line_radio([0.0, 0.5, 0.9, 5.0], blocked=blocked)

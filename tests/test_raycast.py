@@ -17,9 +17,10 @@ import pytest
 
 from mjswarm.arena import load_arena
 from mjswarm.arena.builder import arena_world_spec
-from mjswarm.bearing import BearingSensor, line_of_sight
+from mjswarm.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
 from mjswarm.raycast import RayCaster, Rays
+from mjswarm.sight import LineOfSight
 from mjswarm.simulation import GRID_SENSING_MIN_ROBOTS, Simulation
 from mjswarm.world import Pose2D, world_spec
 
@@ -137,7 +138,7 @@ def test_bearing_line_of_sight_equals_mj_ray():
     grid.set_state(*random_state(grid, rng, tipped=0.0))
     k, p = np.nonzero(~np.eye(grid.n, dtype=bool))
     poses = grid.poses()
-    fast = line_of_sight(grid, k, p, poses)
+    fast = grid.sight(k, p)
     geomid = np.zeros(1, np.int32)
     for i, j, seen in zip(k, p, fast):
         start = np.array([poses[i, 0], poses[i, 1], 0.06])
@@ -147,6 +148,27 @@ def test_bearing_line_of_sight_equals_mj_ray():
         assert seen == (geomid[0] >= 0 and grid.geom_robot[geomid[0]] == j)
     assert fast.any() and not fast.all()
     assert all(set(seen) <= set(range(grid.n)) for seen in BearingSensor(grid).read())
+
+
+def test_line_of_sight_is_cast_once_per_state_and_equals_a_fresh_cast():
+    grid, _ = arena_sims()
+    rng = np.random.default_rng(6)
+    grid.set_state(*random_state(grid, rng, tipped=0.0))
+    k, p = np.nonzero(~np.eye(grid.n, dtype=bool))
+    some = rng.permutation(len(k))[: len(k) // 3]
+    first = grid.sight(k[some], p[some])
+    cast = grid.sight.rays_cast
+    assert cast == len(some)
+    full = grid.sight(k, p)  # only the other two thirds are cast
+    assert grid.sight.rays_cast == len(k) and np.array_equal(full[some], first)
+    assert np.array_equal(full, LineOfSight(grid)(k, p))
+    assert np.array_equal(grid.sight(k[some][::-1], p[some][::-1]), first[::-1])
+    assert grid.sight.rays_cast == len(k)
+    grid.set_velocity(np.full(grid.n, 0.2), np.linspace(-2, 2, grid.n))
+    grid.step(5)  # a new state: answers are cast again
+    moved = grid.sight(k, p)
+    assert grid.sight.rays_cast == 2 * len(k)
+    assert np.array_equal(moved, LineOfSight(grid)(k, p)) and not np.array_equal(moved, full)
 
 
 def test_auto_sensing_switches_to_the_grid_for_large_teams():
@@ -162,7 +184,7 @@ def test_bad_sensing_and_unsupported_geoms_are_one_line_errors():
     spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[0.05, 0.1, 0], pos=[1, 1, 0.1])
     with pytest.raises(MjswarmError, match="CAPSULE.*sensing='mujoco'"):
         Simulation(spec, sensing="grid")
-    spec = world_spec([Pose2D(0, 0, 0)])
+    spec = world_spec([Pose2D(0, 0, 0), Pose2D(0.3, 0, np.pi)])
     spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[0.05, 0.1, 0], pos=[1, 1, 0.1])
     sim = Simulation(spec, sensing="mujoco")  # MuJoCo's rangefinders see capsules
     sim.step()

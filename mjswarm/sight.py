@@ -1,0 +1,80 @@
+"""Line of sight between robots: cast once per world state, shared by every sensor.
+
+Robot ``k`` sees robot ``p`` when a ray from ``k``'s centre at ``RAY_HEIGHT_M``, towards
+``p``'s centre, hits ``p`` first; only collision geoms (group 0: walls and robots) block.
+The bearing sensor (:mod:`mjswarm.bearing`) asks this for the ordered pairs in its field of
+view, the radio (:func:`mjswarm.awareness.sight_blocker`) for both directions of every
+pair in range. :class:`LineOfSight` answers each ordered pair once per world state (the
+simulation's ``state_version``), so the bearing sensor's rays, a subset of the radio's
+when both have the same range, cost nothing in a tick where the radio has already asked.
+The rays are cast by the simulation's :class:`~mjswarm.raycast.RayCaster`, which answers as
+``mj_ray`` does (``tests/test_raycast.py`` checks every ordered pair against ``mj_ray``).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from mjswarm.raycast import Rays
+
+if TYPE_CHECKING:
+    from mjswarm.simulation import Simulation
+
+RAY_HEIGHT_M = 0.06  # above the wheels (0.05 m), inside the chassis (0.012..0.07 m)
+_GROUP0 = np.array([1, 0, 0, 0, 0, 0], dtype=np.uint8)
+
+
+class LineOfSight:
+    """``sight(k, p)``: for every ordered pair ``(k[i], p[i])``, whether ``k`` sees ``p``.
+
+    Answers are kept, keyed ``k * N + p``, until the simulation's state changes.
+    """
+
+    def __init__(self, sim: Simulation) -> None:
+        self.sim = sim
+        self._version = -1
+        self._keys = np.empty(0, np.int64)
+        self._seen = np.empty(0, bool)
+        self.rays_cast = 0  #: rays cast so far (each ordered pair once per state)
+
+    def __call__(self, k: np.ndarray, p: np.ndarray) -> np.ndarray:
+        n = self.sim.n
+        if self._version != self.sim.state_version:
+            self._version = self.sim.state_version
+            self._keys, self._seen = np.empty(0, np.int64), np.empty(0, bool)
+        key = np.asarray(k, np.int64) * n + np.asarray(p, np.int64)
+        where = self._find(key)
+        missing = where < 0
+        if missing.any():
+            new = np.unique(key[missing])
+            keys = np.concatenate([self._keys, new])
+            seen = np.concatenate([self._seen, self._cast(new // n, new % n)])
+            order = np.argsort(keys, kind="stable")
+            self._keys, self._seen = keys[order], seen[order]
+            where = self._find(key)
+        return self._seen[where]
+
+    def _find(self, key: np.ndarray) -> np.ndarray:
+        """Index of each key among the answered ones, -1 where not answered yet."""
+        if not len(self._keys):
+            return np.full(len(key), -1)
+        at = np.searchsorted(self._keys, key).clip(max=len(self._keys) - 1)
+        return np.where(self._keys[at] == key, at, -1)
+
+    def _cast(self, k: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """Every geom of ``p`` lies within ``R`` of its centre, so a ray of length
+        ``|p - k| + R`` finds ``p`` if ``mj_ray`` would; coincident robots do not see
+        each other."""
+        sim = self.sim
+        poses = sim.poses()
+        vec = poses[p, :2] - poses[k, :2]
+        dist = np.hypot(vec[:, 0], vec[:, 1])
+        apart = dist > 0
+        unit = np.column_stack([vec / np.where(apart, dist, 1.0)[:, None], np.zeros(len(k))])
+        unit[~apart, 0] = 1.0
+        start = np.column_stack([poses[k, :2], np.full(len(k), RAY_HEIGHT_M)])
+        self.rays_cast += len(k)
+        _, geom = sim.rays.cast(Rays(start, unit, dist + sim.rays.robot_radius_m, sim.robot_bodies[k]), _GROUP0)
+        return apart & (geom >= 0) & (sim.geom_robot[geom] == p)
