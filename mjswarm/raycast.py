@@ -21,8 +21,11 @@ line-by-line transcription of MuJoCo's ``mju_rayGeom`` (``engine_ray.c``: ``ray_
 ``ray_sphere``, ``ray_box``, ``ray_cylinder`` with their bounding-sphere tests and the
 ``mjMINVAL`` guards), with ``mj_ray``'s elimination rules (the excluded body, invisible
 geoms by ``rgba`` or material alpha, geom groups). Ties go to the lower geom id, as in
-``mj_ray``. The per-ray loop is compiled with numba and runs the rays in parallel
-(``prange``, one thread per core unless ``NUMBA_NUM_THREADS`` says otherwise).
+``mj_ray``. The per-ray loop is compiled with numba as a parallel loop over rays, its
+helpers inlined, and runs on ``threads`` threads (default 1: a second thread only pays on
+an otherwise idle core, and ``mjswarm sweep`` already fills the cores with processes; the
+parallel kernel is kept because numba compiles it to faster code than a plain loop, also
+on one thread).
 ``tests/test_raycast.py`` checks distances within 1e-9 and geom ids against ``mj_ray`` on
 random states.
 
@@ -36,6 +39,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import mujoco
+import numba
 import numpy as np
 from numba import njit, prange
 
@@ -75,12 +79,16 @@ class RayCaster:
         robot_bodies: (N,) root body id of each robot.
         geom_robot: (ngeom,) robot index owning each geom, -1 for others.
         cell_m: grid cell size (m) for the world's static geoms.
+        threads: numba threads a cast runs on (1 .. ``numba.config.NUMBA_NUM_THREADS``).
     """
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, robot_bodies: np.ndarray,
-                 geom_robot: np.ndarray, cell_m: float = DEFAULT_CELL_M) -> None:
+                 geom_robot: np.ndarray, cell_m: float = DEFAULT_CELL_M, threads: int = 1) -> None:
         if cell_m <= 0:
             raise MjswarmError(f"ray grid cell size must be positive, got {cell_m} m")
+        if not 1 <= threads <= numba.config.NUMBA_NUM_THREADS:
+            raise MjswarmError(f"ray casting threads must be 1..{numba.config.NUMBA_NUM_THREADS}, got {threads}")
+        self.threads = threads
         m = model
         self.model, self.data, self.robot_bodies = m, data, np.asarray(robot_bodies)
         mat_alpha = np.append(m.mat_rgba[:, 3], 1.0)  # index -1: no material
@@ -155,8 +163,7 @@ class RayCaster:
         """Nearest hit of every ray within its length: (distance, geom id), -1 where none.
 
         ``geomgroup`` is ``mj_ray``'s: None tests every group, else a 0/1 flag per group.
-        Static geoms are always tested (``mj_ray``'s ``flg_static = 1``). Rays are cast in
-        parallel on numba's threads (one per core by default; ``numba.set_num_threads``).
+        Static geoms are always tested (``mj_ray``'s ``flg_static = 1``).
         """
         m, d = self.model, self.data
         groups = np.ones(mujoco.mjNGROUP, bool) if geomgroup is None else np.asarray(geomgroup, bool)
@@ -167,13 +174,18 @@ class RayCaster:
         robot_start = np.searchsorted(cells[order], np.arange(self._shape[0] * self._shape[1] + 1))
         n = len(rays.length)
         dist, geom = np.full(n, -1.0), np.full(n, -1, np.int64)
-        _cast(np.ascontiguousarray(rays.origin, float), np.ascontiguousarray(rays.direction, float),
-              np.asarray(rays.length, float), np.asarray(rays.exclude_body, np.int64), candidate,
-              m.geom_type, m.geom_bodyid, d.geom_xpos, d.geom_xmat, m.geom_size, m.geom_rbound,
-              self.always, self._origin, self.cell_m, np.array(self._shape, np.int64),
-              self._cell_start, self._cell_geoms, self._static_box, self._static_corner,
-              robot_start, order.astype(np.int64), centres,
-              self._robot_geom_start, self._robot_geoms, self.robot_radius_m, dist, geom)
+        threads = numba.get_num_threads()
+        numba.set_num_threads(self.threads)
+        try:
+            _cast(np.ascontiguousarray(rays.origin, float), np.ascontiguousarray(rays.direction, float),
+                  np.asarray(rays.length, float), np.asarray(rays.exclude_body, np.int64), candidate,
+                  m.geom_type, m.geom_bodyid, d.geom_xpos, d.geom_xmat, m.geom_size, m.geom_rbound,
+                  self.always, self._origin, self.cell_m, np.array(self._shape, np.int64),
+                  self._cell_start, self._cell_geoms, self._static_box, self._static_corner,
+                  robot_start, order.astype(np.int64), centres,
+                  self._robot_geom_start, self._robot_geoms, self.robot_radius_m, dist, geom)
+        finally:
+            numba.set_num_threads(threads)
         return dist, geom
 
     def _flat(self, cells: np.ndarray) -> np.ndarray:
@@ -181,12 +193,12 @@ class RayCaster:
 
 
 # ----------------------------------------------------------------- the compiled ray loop
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _cast(origin, direction, length, exclude_body, candidate, geom_type, geom_bodyid, geom_xpos,
           geom_xmat, geom_size, geom_rbound, always, grid_origin, cell_m, shape, cell_start,
           cell_geoms, static_box, static_corner, robot_start, robots, centres, robot_geom_start,
           robot_geoms, robot_radius, out_dist, out_geom):  # pragma: no cover (compiled)
-    """Every ray's nearest hit (``out_dist``, ``out_geom``); rays in parallel (``prange``).
+    """Every ray's nearest hit (``out_dist``, ``out_geom``).
 
     A static geom spanning several cells of the ray's box is tested once, in the first of
     them (its ``static_corner`` clipped to the box), and only if the segment meets its
@@ -234,14 +246,14 @@ def _cast(origin, direction, length, exclude_body, candidate, geom_type, geom_bo
         out_dist[r], out_geom[r] = best, best_geom
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
 def _cell(x, y, grid_origin, cell_m, shape):  # pragma: no cover (compiled)
     cx = min(max(int(np.floor((x - grid_origin[0]) / cell_m)), 0), shape[0] - 1)
     cy = min(max(int(np.floor((y - grid_origin[1]) / cell_m)), 0), shape[1] - 1)
     return cx, cy
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
 def _gap_sq(point, pnt, vec, top):  # pragma: no cover (compiled)
     """Squared distance from ``point`` to the segment ``pnt + t vec``, ``0 <= t <= top``."""
     d0, d1, d2 = point[0] - pnt[0], point[1] - pnt[1], point[2] - pnt[2]
@@ -251,7 +263,7 @@ def _gap_sq(point, pnt, vec, top):  # pragma: no cover (compiled)
     return g0 * g0 + g1 * g1 + g2 * g2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
 def _meets_box(box, g, pnt, vec, top):  # pragma: no cover (compiled)
     """Whether the segment ``pnt + t vec``, ``0 <= t <= top``, meets geom ``g``'s box
     ``box[g, :3] <= x <= box[g, 3:]`` (slab test)."""
@@ -268,7 +280,7 @@ def _meets_box(box, g, pnt, vec, top):  # pragma: no cover (compiled)
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
 def _try(g, best, best_geom, pnt, vec, top, skip, candidate, geom_type, geom_bodyid, geom_xpos,
          geom_xmat, geom_size, geom_rbound):  # pragma: no cover (compiled)
     """mj_ray's elimination, the segment test, mju_rayGeom, and the nearest-hit update."""
@@ -287,7 +299,7 @@ def _try(g, best, best_geom, pnt, vec, top, skip, candidate, geom_type, geom_bod
 
 
 # ------------------------------------------------- engine_ray.c, transcribed for numba
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _ray_quad(a, b, c):  # pragma: no cover (compiled)
     """``ray_quad``: smallest non-negative root of ``a x^2 + 2 b x + c = 0``, or -1."""
     det = b * b - a * c
@@ -302,7 +314,7 @@ def _ray_quad(a, b, c):  # pragma: no cover (compiled)
     return -1.0, x0, x1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _ray_sphere(pos, dist_sqr, pnt, vec):  # pragma: no cover (compiled)
     d0, d1, d2 = pnt[0] - pos[0], pnt[1] - pos[1], pnt[2] - pos[2]
     a = vec[0] * vec[0] + vec[1] * vec[1] + vec[2] * vec[2]
@@ -311,7 +323,7 @@ def _ray_sphere(pos, dist_sqr, pnt, vec):  # pragma: no cover (compiled)
     return _ray_quad(a, b, c)[0]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _ray_map(pos, mat, pnt, vec):  # pragma: no cover (compiled)
     """``ray_map``: the ray in the geom's frame, ``lpnt = mat' (pnt - pos)``, ``lvec = mat' vec``."""
     d0, d1, d2 = pnt[0] - pos[0], pnt[1] - pos[1], pnt[2] - pos[2]
@@ -323,7 +335,7 @@ def _ray_map(pos, mat, pnt, vec):  # pragma: no cover (compiled)
              mat[2] * vec[0] + mat[5] * vec[1] + mat[8] * vec[2]))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _ray_geom(kind, pos, mat, size, pnt, vec):  # pragma: no cover (compiled)
     """``mju_rayGeom`` for planes, spheres, boxes and cylinders: distance or -1."""
     if kind == SPHERE:

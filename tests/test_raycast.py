@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 import mujoco
+import numba
 import numpy as np
 import pytest
 
@@ -130,6 +131,9 @@ def test_ray_caster_equals_mj_ray(seed):
             want = (ref, geomid[0]) if 0 <= ref <= rays.length[k] else (-1.0, -1)
             assert dist[k] == pytest.approx(want[0], abs=TOLERANCE) and geom[k] == want[1], k
         assert (geom >= 0).sum() > count // 4  # the rays do hit things
+        if numba.config.NUMBA_NUM_THREADS >= 2:  # the same answers on two threads, bit for bit
+            two = RayCaster(m, d, grid.robot_bodies, grid.geom_robot, threads=2)
+            assert all(np.array_equal(a, b) for a, b in zip(two.cast(rays, group), (dist, geom)))
 
 
 def test_bearing_line_of_sight_equals_mj_ray():
@@ -190,6 +194,8 @@ def test_bad_sensing_and_unsupported_geoms_are_one_line_errors():
     sim.step()
     with pytest.raises(MjswarmError, match="CAPSULE"):
         BearingSensor(sim).read()
+    with pytest.raises(MjswarmError, match="threads must be"):
+        RayCaster(sim.model, sim.data, sim.robot_bodies, sim.geom_robot, threads=0)
     with pytest.raises(MjswarmError, match="cell size"):
         sim = Simulation(world_spec([Pose2D(0, 0, 0)]), sensing="grid")
         RayCaster(sim.model, sim.data, sim.robot_bodies, sim.geom_robot, cell_m=0.0)
