@@ -130,6 +130,7 @@ class RayCaster:
         self._origin = np.minimum(lo.min(axis=0, initial=np.inf), robots.min(axis=0))
         top = np.maximum(hi.max(axis=0, initial=-np.inf), robots.max(axis=0))
         self._shape = tuple(int(k) for k in np.floor((top - self._origin) / cell_m) + 1)
+        self._shape_array = np.array(self._shape, np.int64)
         lo_cell = self._cells(lo)
         cells, owner = self._expand(lo_cell, self._cells(hi))
         # per static geom: its first cell, and its world AABB grown by 1 um (a hit lies on
@@ -141,12 +142,14 @@ class RayCaster:
         self._static_box[geoms] = np.hstack([centre - half - grow, centre + half + grow])
         order = np.argsort(cells, kind="stable")
         self._cell_geoms = geoms[owner[order]].astype(np.int64)
-        self._cell_start = np.searchsorted(cells[order], np.arange(self._shape[0] * self._shape[1] + 1))
+        self._cell_ids = np.arange(self._shape[0] * self._shape[1] + 1)
+        self._cell_start = np.searchsorted(cells[order], self._cell_ids)
+        self._candidates: dict[bytes | None, np.ndarray] = {}  # geomgroup -> geoms it may hit
 
     def _cells(self, xy: np.ndarray) -> np.ndarray:
         """Grid (ix, iy) of points, clipped to the grid."""
         idx = np.floor((xy - self._origin) / self.cell_m).astype(np.int64)
-        return np.clip(idx, 0, np.array(self._shape) - 1)
+        return np.clip(idx, 0, self._shape_array - 1)
 
     def _expand(self, c0: np.ndarray, c1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """All cells of the boxes ``c0..c1`` (inclusive): (flat cell ids, box index)."""
@@ -166,12 +169,15 @@ class RayCaster:
         Static geoms are always tested (``mj_ray``'s ``flg_static = 1``).
         """
         m, d = self.model, self.data
-        groups = np.ones(mujoco.mjNGROUP, bool) if geomgroup is None else np.asarray(geomgroup, bool)
-        candidate = self.visible & groups[self.group]
+        key = None if geomgroup is None else bytes(np.asarray(geomgroup, bool))
+        candidate = self._candidates.get(key)
+        if candidate is None:
+            groups = np.ones(mujoco.mjNGROUP, bool) if key is None else np.asarray(geomgroup, bool)
+            candidate = self._candidates[key] = self.visible & groups[self.group]
         centres = d.xpos[self.robot_bodies]
         cells = self._flat(self._cells(centres[:, :2]))
         order = np.argsort(cells, kind="stable")
-        robot_start = np.searchsorted(cells[order], np.arange(self._shape[0] * self._shape[1] + 1))
+        robot_start = np.searchsorted(cells[order], self._cell_ids)
         n = len(rays.length)
         dist, geom = np.full(n, -1.0), np.full(n, -1, np.int64)
         threads = numba.get_num_threads()
@@ -180,7 +186,7 @@ class RayCaster:
             _cast(np.ascontiguousarray(rays.origin, float), np.ascontiguousarray(rays.direction, float),
                   np.asarray(rays.length, float), np.asarray(rays.exclude_body, np.int64), candidate,
                   m.geom_type, m.geom_bodyid, d.geom_xpos, d.geom_xmat, m.geom_size, m.geom_rbound,
-                  self.always, self._origin, self.cell_m, np.array(self._shape, np.int64),
+                  self.always, self._origin, self.cell_m, self._shape_array,
                   self._cell_start, self._cell_geoms, self._static_box, self._static_corner,
                   robot_start, order.astype(np.int64), centres,
                   self._robot_geom_start, self._robot_geoms, self.robot_radius_m, dist, geom)

@@ -152,8 +152,11 @@ class Simulation:
         self.collisions = CollisionCounter(geom_robot)
         self.battery = Battery(self.n)
         self.step_count = 0
-        #: changes whenever the world's state does (a step, or the experimenter's hand)
+        #: changes whenever the world's state does (a step, or the experimenter's hand
+        #: through :meth:`set_state` or :meth:`place_robot`; writing ``data.qpos``
+        #: directly bypasses it)
         self.state_version = 0
+        self._poses_version = -1
         self._sight: LineOfSight | None = None
         if sensing == "grid":
             m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
@@ -315,13 +318,16 @@ class Simulation:
         return float(self.data.time)
 
     def poses(self) -> np.ndarray:
-        """Ground-truth planar poses, shape (N, 3): x (m), y (m), yaw (rad). Not for controllers."""
-        q = self.data.qpos
-        adr = self._qpos_adr
-        xy = np.stack([q[adr], q[adr + 1]], axis=1)
-        w, x, y, z = (q[adr + k] for k in range(3, 7))
-        yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-        return np.column_stack([xy, yaw])
+        """Ground-truth planar poses, shape (N, 3): x (m), y (m), yaw (rad). Not for controllers.
+
+        Computed once per state (``state_version``); each call returns a fresh copy."""
+        if self._poses_version != self.state_version:
+            q = self.data.qpos[self._qpos_adr[:, None] + np.arange(7)]
+            w, x, y, z = q[:, 3], q[:, 4], q[:, 5], q[:, 6]
+            yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+            self._poses = np.column_stack([q[:, 0], q[:, 1], yaw])
+            self._poses_version = self.state_version
+        return self._poses.copy()
 
     def heights(self) -> np.ndarray:
         """Ground-truth axle heights (m), shape (N,)."""
