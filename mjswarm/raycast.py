@@ -168,6 +168,10 @@ class RayCaster:
         ``geomgroup`` is ``mj_ray``'s: None tests every group, else a 0/1 flag per group.
         Static geoms are always tested (``mj_ray``'s ``flg_static = 1``).
         """
+        n = len(rays.length)
+        dist, geom = np.full(n, -1.0), np.full(n, -1, np.int64)
+        if n == 0:
+            return dist, geom
         m, d = self.model, self.data
         key = None if geomgroup is None else bytes(np.asarray(geomgroup, bool))
         candidate = self._candidates.get(key)
@@ -178,8 +182,6 @@ class RayCaster:
         cells = self._flat(self._cells(centres[:, :2]))
         order = np.argsort(cells, kind="stable")
         robot_start = np.searchsorted(cells[order], self._cell_ids)
-        n = len(rays.length)
-        dist, geom = np.full(n, -1.0), np.full(n, -1, np.int64)
         threads = numba.get_num_threads()
         numba.set_num_threads(self.threads)
         try:
