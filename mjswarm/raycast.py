@@ -190,7 +190,7 @@ class RayCaster:
                   m.geom_type, m.geom_bodyid, d.geom_xpos, d.geom_xmat, m.geom_size, m.geom_rbound,
                   self.always, self._origin, self.cell_m, self._shape_array,
                   self._cell_start, self._cell_geoms, self._static_box, self._static_corner,
-                  robot_start, order.astype(np.int64), centres,
+                  robot_start, order, centres,
                   self._robot_geom_start, self._robot_geoms, self.robot_radius_m, dist, geom)
         finally:
             numba.set_num_threads(threads)

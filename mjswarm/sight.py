@@ -37,9 +37,7 @@ class LineOfSight:
         self._version = -1
         self._keys = np.empty(0, np.int64)
         self._seen = np.empty(0, bool)
-        #: rays cast so far (each ordered pair once per state, unless asked twice in the
-        #: first call for that state)
-        self.rays_cast = 0
+        self.rays_cast = 0  #: rays cast so far (each ordered pair once per state)
 
     def __call__(self, k: np.ndarray, p: np.ndarray) -> np.ndarray:
         n = self.sim.n
@@ -47,10 +45,7 @@ class LineOfSight:
         key = k * n + p
         if self._version != self.sim.state_version:  # a new state: nothing known yet
             self._version = self.sim.state_version
-            seen = self._cast(k, p)
-            order = np.argsort(key, kind="stable")
-            self._keys, self._seen = key[order], seen[order]
-            return seen
+            self._keys, self._seen = np.empty(0, np.int64), np.empty(0, bool)
         where = self._find(key)
         missing = where < 0
         if missing.any():

@@ -139,6 +139,7 @@ class Simulation:
         self.robot_bodies = ids(mujoco.mjtObj.mjOBJ_BODY, (ROOT_BODY,))[:, 0]
         joints = m.body_jntadr[self.robot_bodies]
         self._qpos_adr = m.jnt_qposadr[joints]
+        self._pose_qpos = self._qpos_adr[:, None] + np.arange(7)  # free joints: xyz, quat
         geom_robot = np.full(m.ngeom, -1, dtype=np.int64)
         for i, root in enumerate(self.robot_bodies):
             geom_robot[np.isin(m.geom_bodyid, self._subtree(root))] = i
@@ -322,7 +323,7 @@ class Simulation:
 
         Computed once per state (``state_version``); each call returns a fresh copy."""
         if self._poses_version != self.state_version:
-            q = self.data.qpos[self._qpos_adr[:, None] + np.arange(7)]
+            q = self.data.qpos[self._pose_qpos]
             w, x, y, z = q[:, 3], q[:, 4], q[:, 5], q[:, 6]
             yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
             self._poses = np.column_stack([q[:, 0], q[:, 1], yaw])
