@@ -124,8 +124,10 @@ class Radio:
         self.sent: dict[Hashable, int] = dict.fromkeys(self.robots, 0)
         #: copies received per robot
         self.received: dict[Hashable, int] = dict.fromkeys(self.robots, 0)
-        #: copies lost to ``drop_prob``
+        #: copies lost to ``drop_prob`` or a blackout
         self.dropped = 0
+        #: while True, every copy is lost (fault injection: a radio blackout)
+        self.blackout = False
         #: number of :meth:`step` calls so far
         self.tick = 0
         if edges is not None:
@@ -227,7 +229,7 @@ class Radio:
             for r in recipients:
                 if r not in self._present:
                     continue
-                if self.drop_prob and self._rng.random() < self.drop_prob:
+                if self.blackout or (self.drop_prob and self._rng.random() < self.drop_prob):
                     self.dropped += 1
                     continue
                 self._inbox[r].append(message)

@@ -83,6 +83,9 @@ class Simulation:
             and IR rangefinder readings (m) that saw something; 0 by default.
         sensing: ``"grid"`` (O(N) ray casting), ``"mujoco"`` (MuJoCo's sensors) or
             ``"auto"``; see the module docstring.
+        wheel_slip: wheel slip seen by the encoders: each control tick, each wheel's
+            encoder advances by its true rotation times ``1 + |n|``, ``n ~ N(0,
+            wheel_slip)`` (the wheel spun that much more than it rolled); 0 by default.
     """
 
     def __init__(
@@ -93,11 +96,14 @@ class Simulation:
         line_noise_m: float = 0.0,
         ir_noise_m: float = 0.0,
         sensing: str = "auto",
+        wheel_slip: float = 0.0,
     ) -> None:
         if control_hz <= 0:
             raise MjswarmError(f"control rate must be positive, got {control_hz} Hz")
         if line_noise_m < 0 or ir_noise_m < 0:
             raise MjswarmError("sensor noise standard deviations must be >= 0")
+        if not 0.0 <= wheel_slip < 1.0:
+            raise MjswarmError(f"wheel slip must be in [0, 1), got {wheel_slip}")
         if sensing not in SENSING:
             raise MjswarmError(f"sensing must be one of {', '.join(SENSING)}, got '{sensing}'")
         try:
@@ -117,6 +123,7 @@ class Simulation:
         self.control_dt_s = self.substeps * m.opt.timestep
         self.rng = np.random.default_rng(seed)
         self.line_noise_m, self.ir_noise_m = line_noise_m, ir_noise_m
+        self.wheel_slip = wheel_slip
 
         def ids(obj, names):
             return np.array(
@@ -152,6 +159,7 @@ class Simulation:
         self.geometry = measure_geometry(m, "r0/")
         self.collisions = CollisionCounter(geom_robot)
         self.battery = Battery(self.n)
+        self._slip_rad = np.zeros((self.n, 2))  # encoder over-reading from wheel slip
         self.step_count = 0
         #: changes whenever the world's state does (a step, or the experimenter's hand
         #: through :meth:`set_state` or :meth:`place_robot`; writing ``data.qpos``
@@ -227,6 +235,7 @@ class Simulation:
         q[adr + 3:adr + 7] = yaw_quat(pose.yaw)
         self.data.qvel[dof:dof + 6] = 0.0
         self.data.ctrl[self._actuators[i]] = 0.0
+        self.data.act[self.model.actuator_actadr[self._actuators[i]]] = 0.0  # motor ramp
         self._sense_now()
 
     def set_state(self, qpos: np.ndarray, qvel: np.ndarray) -> None:
@@ -264,7 +273,13 @@ class Simulation:
             self.state_version += 1
             self.battery.update(d.actuator_force[self._actuators], self.control_dt_s)
             self.collisions.update(d)
+            previous = self._readings["encoder"] - self._slip_rad
             self._readings = self._read_sensors()
+            if self.wheel_slip:
+                turned = self._readings["encoder"] - self._slip_rad - previous
+                slip = np.abs(self.rng.normal(0.0, self.wheel_slip, turned.shape)) * turned
+                self._slip_rad += slip
+                self._readings["encoder"] += slip
 
     def _wheel_state(self) -> tuple[np.ndarray, np.ndarray]:
         """Wheel angles (rad) and speeds (rad/s) now: the encoders' ``qpos`` / ``qvel``."""
@@ -305,6 +320,7 @@ class Simulation:
             out["encoder"], out["wheel_speed"] = sd[self._enc_adr], sd[self._vel_adr]
         else:
             out["encoder"], out["wheel_speed"] = self._wheels
+        out["encoder"] += self._slip_rad
         out["battery"] = self.battery.voltage_v
         return out
 

@@ -27,7 +27,8 @@ def test_paper_arenas_complete_with_the_true_map(arena, robots):
     assert result.completed
     assert result.map_edges == truth(arena) and result.map_correct
     assert result.collisions == 0
-    assert result.lost_robots == []
+    assert result.stopped_robots == []
+    assert result.ended_because == "completed"
     assert result.makespan <= result.total_traversals
 
 
@@ -86,9 +87,17 @@ def test_cli_embodied_json_and_recording(tmp_path, capsys):
         (["--launch-order", "a,b"], "--launch-order takes robot numbers"),
         (["--world", "moon"], "unknown world"),
         (["--robots", "0"], "at least one robot"),
+        (["--fault", "quake@3"], "bad fault 'quake@3'"),
+        (["--fault", "robot:7@3"], "there are robots 1..2"),
+        (["--fault", "beacon:v99@3"], "'v99' is not a vertex"),
+        (["--fault", "radio-blackout@3-9"], "needs robots with radios"),
+        (["--stall-timeout", "0"], "stall timeout must be positive"),
+        (["--wheel-slip", "-0.1"], "wheel slip must be in [0, 1)"),
+        (["--line-noise", "-1"], "noise standard deviations must be >= 0"),
     ],
 )
 def test_cli_embodied_bad_input_is_one_line(capsys, argv, message):
+    """Each bad option: exit 2 and one line naming the problem."""
     base = ["explore", "--arena", "fig9", "--robots", "2"]
     args = base + argv
     if "--robots" in argv:

@@ -25,7 +25,7 @@ from mjswarm.world import Pose2D
 
 SPEED_M_S = 0.1
 ARRIVAL_TOLERANCE_M = 0.02
-ANGLE_TOLERANCE_DEG = 10.0
+ANGLE_TOLERANCE_DEG = 4.0
 MAX_TICKS_PER_LEG = 50 * 120  # two simulated minutes
 
 

@@ -107,6 +107,44 @@ def test_ir_reads_nothing_beyond_range(gap_m):
     assert np.isnan(sim.readings()["ir"][0]).all()
 
 
+@pytest.mark.parametrize("speed", [0.1, 0.2])
+def test_a_sudden_stop_does_not_pitch_the_line_sensors_onto_a_strip(one_robot, speed):
+    """Issue 13: the motor ramp keeps the line sensors within 0.5 mm of their bare-floor
+    reading when a robot is told to stop dead from cruising (an instant stop dipped them by
+    the 2 mm of a strip, and robots then followed phantom lanes)."""
+    for _ in range(100):
+        one_robot.set_velocity(speed, 0.0)
+        one_robot.step()
+    floor = one_robot.readings()["line"][0].min()  # cruising over bare floor
+    lowest = floor
+    for _ in range(50):
+        one_robot.set_velocity(0.0, 0.0)
+        one_robot.step()
+        lowest = min(lowest, one_robot.readings()["line"][0].min())
+    assert floor - lowest < 0.0005
+
+
+def test_wheel_slip_makes_encoders_over_read_and_is_seeded():
+    """--wheel-slip: the encoders advance by more than the wheels rolled, by a seeded
+    random share; the physics is untouched."""
+    def drive(slip, seed):
+        sim = Simulation(world_spec([Pose2D(0.0, 0.0, 0.0)], margin_m=2.0), seed=seed,
+                         wheel_slip=slip)
+        for _ in range(50):
+            sim.set_velocity(0.1, 0.0)
+            sim.step()
+        return sim.readings()["encoder"][0].copy(), sim.poses()[0].copy()
+    clean, pose = drive(0.0, 0)
+    slipped, slipped_pose = drive(0.05, 0)
+    again, _ = drive(0.05, 0)
+    other, _ = drive(0.05, 1)
+    assert np.array_equal(pose, slipped_pose)
+    assert np.all(slipped > clean) and np.all(slipped < clean * 1.1)
+    assert np.array_equal(slipped, again) and not np.array_equal(slipped, other)
+    with pytest.raises(MjswarmError, match="wheel slip"):
+        Simulation(world_spec([Pose2D(0.0, 0.0, 0.0)]), wheel_slip=-0.1)
+
+
 def test_ten_minutes_of_random_commands_stay_stable():
     """Like menagerie's model tests: no NaN, no warning, upright, on the floor."""
     walls = [WallSegment(a, b) for a, b in [((-1, -1), (1, -1)), ((1, -1), (1, 1)),

@@ -90,6 +90,10 @@ class Strategy(ABC):
 
     #: CLI name of the strategy.
     name: ClassVar[str]
+    #: After a call of :meth:`on_vertex`: the incidence angles (rad) the vertex's beacon
+    #: stored before this visit, the common frame an embodied robot re-anchors its
+    #: heading to; None when the robot has just dropped the beacon (its own angles).
+    stored_angles: tuple[float, ...] | None = None
 
     def __init__(self, index: int, n_robots: int, rng: np.random.Generator | None = None):
         if n_robots < 1 or not 0 <= index < n_robots:

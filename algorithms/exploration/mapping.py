@@ -78,10 +78,11 @@ class MapStrategy(Strategy):
             row = tuple(sorted(normalize_angle(a) for a in angles))
             record = beacon.data = self.new_record(IncidenceMatrix.initial(tag, row))
             before = None
+            self.stored_angles = None
         else:
             tag = beacon.id
             before = record.matrix
-            row = before.rows[tag]
+            row = self.stored_angles = before.rows[tag]
         matrix = self.matrix
         if arrived_by is not None and self._left_by is not None:
             self.arrival = match_angle(normalize_angle(arrived_by), row)

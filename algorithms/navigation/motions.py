@@ -19,10 +19,18 @@ HEADING_GAIN = 3.0
 MIN_TURN_RATE = 0.2
 #: A turn is done within this heading error (rad, 0.6 degrees).
 TURN_TOLERANCE = 0.01
+#: Drive slows down to ``DRIVE_GAIN * distance left`` (1/s), but not below DRIVE_MIN_SPEED
+#: (m/s): the wheels' speed ramp (the motor filter of ``models/spark_v.xml``, 0.1 s) then
+#: coasts the robot at most half a millimetre past its goal.
+DRIVE_GAIN = 2.0
+DRIVE_MIN_SPEED = 0.005
 #: Line-following curvature (1/m) per unit of strip position (+1: under the left sensor).
 LINE_CURVATURE = 15.0
-#: The line counts as ended after this many metres without any sensor on it.
+#: A strip lost sideways counts as ended after this many metres without any sensor on it.
 LINE_END_GAP_M = 0.02
+#: A strip's longitudinal end (see FollowLine) must hold for this many control ticks, so
+#: that one noisy reading does not end it.
+END_CONFIRM_TICKS = 2
 
 
 def wrap(angle: float) -> float:
@@ -65,7 +73,7 @@ class Drive:
         left = self.distance_m - (odo.distance_m - self._start)
         if left <= 0.0:
             return None
-        v = min(self.speed, max(0.02, 2.0 * left))
+        v = min(self.speed, max(DRIVE_MIN_SPEED, DRIVE_GAIN * left))
         return v, hold_heading(odo, self.heading)
 
 
@@ -101,9 +109,22 @@ class FollowLine:
     with centre), 0 (centre alone), -0.5 (centre with right), -1 (right alone), and the
     robot steers towards it with curvature ``LINE_CURVATURE * position``. Strips are
     wider than the sensor spacing, so while the robot is near a strip some sensor sees
-    it; when none does the follower keeps its last correction (the strip is beyond the
-    outer sensor, or has ended). It has ended when no sensor has seen it over
-    LINE_END_GAP_M; ``ended_at_m`` is then the odometry distance where it was last seen.
+    it, and a robot drifting sideways off it passes through "centre with a side": the
+    side sensor keeps holding the strip.
+
+    The strip has **ended** in either of two ways; ``ended_at_m`` is then the odometry
+    distance where the centre sensor (or, in the second way, any sensor) last saw it:
+
+    * *longitudinally*: the centre sensor leaves it while no side sensor that saw it
+      together with the centre still does, for ``END_CONFIRM_TICKS`` ticks in a row. A
+      side sensor that turns on just then belongs to another strip: near a vertex centre
+      the inner ends of the spokes of edges 45-90 degrees apart come within a side
+      sensor's reach, and following that sensor would carry the robot out along a
+      neighbouring spoke (issue 13). Drifting sideways never looks like this (the side
+      sensor holding the strip was on before the centre left it);
+    * *laterally lost*: no sensor has seen it over LINE_END_GAP_M; meanwhile the follower
+      keeps its last correction (the strip is beyond the outer sensor).
+
     ``headings`` keeps the odometry headings of the ticks where only the centre sensor
     was on (the robot aligned with the strip), so callers can estimate its direction.
     """
@@ -112,9 +133,29 @@ class FollowLine:
     headings: list[float] = field(default_factory=list)
     ended_at_m: float | None = None
     _position: float = 0.0
+    #: while the centre sensor tracks the strip: the side sensors on with it last tick
+    _holding: tuple[bool, bool] | None = None
+    _centre_left_at_m: float | None = None
+    _centre_off_ticks: int = 0
+    _last_on_m: float = 0.0  # odometry distance at the last tick the centre was on
 
     def step(self, odo: Odometry, percept: Percept):
         left, centre, right = percept.line
+        if centre:
+            self._holding = (left, right)
+            self._centre_off_ticks = 0
+            self._last_on_m = odo.distance_m
+        elif self._holding is not None:
+            if (left and self._holding[0]) or (right and self._holding[1]):
+                self._holding = None  # drifted sideways: a side sensor holds the strip
+            else:  # the centre left the strip lengthwise: its end, once confirmed
+                if self._centre_off_ticks == 0:  # half-way between the two ticks
+                    self._centre_left_at_m = (self._last_on_m + odo.distance_m) / 2.0
+                self._centre_off_ticks += 1
+                if self._centre_off_ticks >= END_CONFIRM_TICKS:
+                    self.ended_at_m = self._centre_left_at_m
+                    return None
+                return self.speed, self.speed * LINE_CURVATURE * self._position
         if left or centre or right:
             self.ended_at_m = None
             side = float(left) - float(right)
@@ -139,7 +180,8 @@ class FollowLine:
 
 @dataclass
 class Scan:
-    """Rotate in place (counter-clockwise) and find the strips around the robot.
+    """Rotate in place (counter-clockwise, or clockwise with ``direction=-1``) and find
+    the strips around the robot.
 
     The centre line sensor sweeps a circle of radius ``line_ahead_m`` around the axle;
     each spoke it crosses gives an interval of headings with the sensor on the strip, and
@@ -150,11 +192,13 @@ class Scan:
     odometry angle between those two crossings, ``full_turn``, is exactly one true turn:
     the navigator uses it to calibrate the odometry's track (wheel sinkage and
     contact-patch scrub make odometry over-read rotation by a few per cent). Results, in
-    odometry angles swept since the start: ``mids`` (one per spoke), ``full_turn`` (None
-    if no spoke came round), ``swept``.
+    odometry angles swept since the start (negative when turning clockwise): ``mids``
+    (one per spoke), ``full_turn`` (always positive; None if no spoke came round),
+    ``swept``.
     """
 
     rate: float
+    direction: int = 1  # +1 counter-clockwise, -1 clockwise
     max_turns: float = 2.5
     mids: list[float] = field(default_factory=list)
     full_turn: float | None = None
@@ -179,12 +223,12 @@ class Scan:
                 self.mids.append((self._on_since + at) / 2.0)
                 self._on_since = None
         self._was_on = on
-        if len(self.mids) > 1 and _same_spoke(self.mids[-1] - self.mids[0]):
-            self.full_turn = self.mids.pop() - self.mids[0]
+        if len(self.mids) > 1 and _same_spoke(abs(self.mids[-1] - self.mids[0])):
+            self.full_turn = abs(self.mids.pop() - self.mids[0])
             return None
-        if self.swept >= 2.0 * math.pi * self.max_turns:
+        if abs(self.swept) >= 2.0 * math.pi * self.max_turns:
             return None
-        return 0.0, self.rate
+        return 0.0, self.direction * self.rate
 
 
 def _same_spoke(swept_between: float) -> bool:

@@ -13,12 +13,22 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
   ``min_wall_run_m`` and then lost, the vertex is detected; the lane then ends;
 * **arriving**: shift right by ``lane_offset_m`` onto the centre line (turn 60 degrees,
   drive, turn back), find and follow the incoming spoke to its inner end, drive
-  ``line_ahead_m + spoke_inner_radius_m`` to stand on the vertex centre;
+  ``line_ahead_m + spoke_inner_radius_m`` to stand on the vertex centre. The approach
+  runs at most at ``APPROACH_SPEED_M_S`` whatever the cruising speed, and the spoke's
+  end is its longitudinal end (:class:`~.motions.FollowLine`), so a neighbouring spoke's
+  inner end, within a side sensor's reach when edges are 45-90 degrees apart, cannot
+  carry the robot away (issue 13);
 * **discovering edges**: rotate once in place (:class:`~.motions.Scan`); every spoke
-  crossed gives an incidence angle, measured with encoder odometry. The robot corrects
-  its heading with the edge it came by: a straight edge leaves ``u`` at angle ``a`` and
-  enters ``v`` at ``a + pi``, so the spoke nearest to that is the incoming one and the
-  difference is odometry drift since leaving ``u``;
+  crossed gives an incidence angle, measured with encoder odometry. The spoke the robot
+  came by lies opposite the lane's direction (measured on the lane, in the odometry
+  frame): it is reported at exactly that angle, and its crossing tells how far the robot
+  stands off-centre across it (:func:`off_centre_correction`). Scans turn
+  counter-clockwise and clockwise in turn: each calibrates the odometry's track, but a
+  residual scale error would add up over a long run's scans if they all turned one way
+  (with one direction a lone robot's heading drifted 12 degrees over the 260 legs of
+  ``lattice:10x10`` at 0.2 m/s, alternating 7; README, "Robustness");
+* **re-anchoring** (:meth:`Navigator.reanchor`): at a vertex whose beacon already stores
+  angles, the caller rotates the robot's frame onto them (:func:`frame_offset`);
 * **leaving**: sidestep from the vertex centre to the left of the chosen spoke by
   ``lane_offset_m`` and find the lane ahead. (Not along the spoke first: two robots
   leaving the two ends of one edge at once would then face each other on its centre line,
@@ -26,13 +36,15 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
 
 Choices: the approach and departure shifts are open-loop odometry manoeuvres at 60
 degrees; the vertex-centre estimate has the accuracy of line following plus a 8 cm
-odometry drive (a few millimetres), which keeps scan angles within a few degrees.
+odometry drive (about a millimetre along the spoke, a few across it, which the incoming
+spoke's crossing corrects), which keeps scan angles within about a degree.
 """
 
 from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import Enum
 
@@ -41,6 +53,11 @@ from algorithms.navigation.odometry import Odometry, RobotCalibration
 from algorithms.navigation.percept import Percept
 
 SHIFT_ANGLE = math.radians(60.0)
+#: Top speed (m/s) of the approach to a vertex centre (finding and following the spoke,
+#: the last drive): the spoke's end, which places the robot on the centre, is then seen
+#: within a millimetre of travel per control tick whatever the cruising speed (at 0.2 m/s
+#: and 50 Hz a tick is 4 mm, and scan angles err by up to 4 degrees).
+APPROACH_SPEED_M_S = 0.05
 
 
 @dataclass(frozen=True)
@@ -83,14 +100,15 @@ class Navigator:
         self.cal, self.conv = calibration, conventions
         self.odometry = Odometry(calibration, theta=heading)
         self.speed = speed_m_s
+        self._approach_speed = min(speed_m_s, APPROACH_SPEED_M_S)
         self.turn_rate = turn_rate_rad_s
         self.state = NavigatorState.AT_VERTEX
         self.edge_angles: list[float] = []
         self.arrived_angle: float | None = None
         self.events: list[str] = []
         self._plan: deque = deque()
-        self._departed: float | None = None
         self._incoming: float | None = None
+        self._scans = 0
         self._tracks: list[float] = []  # effective track estimates, one per scan (m)
         self._lane: FollowLine | None = None
         self._wall_run_start: float | None = None
@@ -106,7 +124,6 @@ class Navigator:
         """Leave the vertex along the spoke at incidence ``angle`` (rad, own frame)."""
         if self.state is not NavigatorState.AT_VERTEX:
             raise RuntimeError(f"depart() needs the robot at a vertex, it is {self.state.value}")
-        self._departed = angle % (2.0 * math.pi)
         self._plan = deque([
             *self._shift(angle, +1),
             (SeekLine(angle, self.speed, self.conv.max_seek_m), self._found_lane),
@@ -128,6 +145,19 @@ class Navigator:
             if on_done is not None:
                 on_done(motion)
         return 0.0, 0.0
+
+    def reanchor(self, stored: Sequence[float]) -> float:
+        """Re-anchor the heading frame to a beacon's stored incidence angles (rad).
+
+        Rotates the odometry heading, the edge angles just measured and the arrival angle
+        by :func:`frame_offset` of the measured angles against ``stored``; returns that
+        rotation (rad)."""
+        delta_rad = frame_offset(self.edge_angles, stored)
+        self.odometry.correct_heading(delta_rad)
+        self.edge_angles = sorted((a + delta_rad) % (2.0 * math.pi) for a in self.edge_angles)
+        if self.arrived_angle is not None:
+            self.arrived_angle = (self.arrived_angle + delta_rad) % (2.0 * math.pi)
+        return delta_rad
 
     @property
     def in_corridor(self) -> bool:
@@ -194,8 +224,8 @@ class Navigator:
         self._incoming = (heading + math.pi) % (2.0 * math.pi)
         self._plan = deque([
             *self._shift(heading, -1),
-            (SeekLine(heading, self.speed, self.conv.max_seek_m), self._found_spoke),
-            (FollowLine(self.speed), self._spoke_ended),
+            (SeekLine(heading, self._approach_speed, self.conv.max_seek_m), self._found_spoke),
+            (FollowLine(self._approach_speed), self._spoke_ended),
         ])
 
     def _found_spoke(self, seek: SeekLine) -> None:
@@ -208,11 +238,14 @@ class Navigator:
         heading = spoke.direction(self.odometry.theta)
         beyond = self.odometry.distance_m - spoke.ended_at_m
         centre = self.cal.line_ahead_m + self.conv.spoke_inner_radius_m - beyond
-        self._plan.append((Drive(centre, heading, self.speed), lambda _: self._start_scan()))
+        self._plan.append((Drive(centre, heading, self._approach_speed),
+                           lambda _: self._start_scan()))
 
     def _start_scan(self) -> None:
         self.state = NavigatorState.SCANNING
-        self._plan = deque([(Scan(self.turn_rate), self._scanned)])
+        self._scans += 1
+        direction = 1 if self._scans % 2 else -1  # alternate: see the module docstring
+        self._plan = deque([(Scan(self.turn_rate, direction), self._scanned)])
 
     def _scanned(self, scan: Scan) -> None:
         """Calibrate, then turn the scan's crossings into incidence angles."""
@@ -238,6 +271,19 @@ class Navigator:
         self.state = NavigatorState.LOST
         self._plan.clear()
         self.events.append(f"lost: {why}")
+
+
+def frame_offset(measured: Sequence[float], stored: Sequence[float]) -> float:
+    """The rotation (rad, in (-pi, pi]) that best carries ``measured`` angles onto
+    ``stored`` ones: the circular mean of ``stored_k - m_k``, ``m_k`` the measured angle
+    nearest to ``stored_k``. Edges at a vertex are at least 45 degrees apart and a
+    robot's heading error stays far below half that, so nearest is the same edge. Every
+    edge counts, not only the one the robot came by: each stored and measured angle errs
+    by up to a degree or so (the scan's sampling and standing off-centre), and the mean
+    over d edges errs about sqrt(d) times less.
+    """
+    diffs = [wrap(s - min(measured, key=lambda m: abs(wrap(m - s)))) for s in stored]
+    return math.atan2(sum(map(math.sin, diffs)), sum(map(math.cos, diffs)))
 
 
 def off_centre_correction(angles: list[float], incoming: float, radius: float) -> list[float]:

@@ -31,6 +31,7 @@ def run_embodied(args) -> dict:
 
     from mjswarm.arena import ArenaSpec, load_arena
     from mjswarm.embodied import EmbodiedConfig, explore_embodied
+    from mjswarm.faults import parse_fault
     from mjswarm.recording import Recorder
 
     spec = load_arena(args.arena)
@@ -48,7 +49,10 @@ def run_embodied(args) -> dict:
         speed_m_s=args.speed, collision_avoidance=not args.no_collision_avoidance,
         launch_interval_s=args.launch_interval, launch_order=order,
         radio_range_m=args.radio_range,
-        max_sim_time_s=args.max_time or EmbodiedConfig.max_sim_time_s)
+        max_sim_time_s=args.max_time or EmbodiedConfig.max_sim_time_s,
+        stall_timeout_s=args.stall_timeout,
+        faults=[parse_fault(f) for f in args.fault],
+        line_noise_m=args.line_noise, ir_noise_m=args.ir_noise, wheel_slip=args.wheel_slip)
     progress = sys.stderr.isatty()
     if args.record:
         with Recorder(args.record, spec, args.robots) as recorder:
@@ -118,6 +122,22 @@ def register(subparsers) -> None:
                           help="give the robots radios of this range (m, walls block) and "
                                "let them keep connectivity tables (seed 004) while they move; "
                                "reports messages and how often beliefs matched the truth")
+    embodied.add_argument("--stall-timeout", type=float, default=None, metavar="S",
+                          help="end the run, not completed, when no robot has reached a vertex "
+                               "for S simulated seconds (default: 300 s, or 10x the time to "
+                               "drive the longest edge if that is longer)")
+    embodied.add_argument("--fault", action="append", default=[], metavar="FAULT",
+                          help="inject a fault (repeatable): robot:I@T (robot I fails at T s "
+                               "and stays as an obstacle), beacon:V@T (the beacon at vertex V "
+                               "is wiped), radio-blackout@T1-T2 (no radio message gets "
+                               "through; needs --radio-range)")
+    embodied.add_argument("--line-noise", type=float, default=0.0, metavar="M",
+                          help="standard deviation of the line sensors' noise, m (default: 0)")
+    embodied.add_argument("--ir-noise", type=float, default=0.0, metavar="M",
+                          help="standard deviation of the IR sensors' noise, m (default: 0)")
+    embodied.add_argument("--wheel-slip", type=float, default=0.0, metavar="S",
+                          help="wheel slip: each tick each encoder over-reads its wheel's "
+                               "turn by |N(0, S)| of it (default: 0)")
     embodied.add_argument("--record", default=None, metavar="FILE.rrd",
                           help="write a rerun recording of the run (open it with "
                                "`mjswarm view FILE.rrd`)")
@@ -141,7 +161,11 @@ def summary(result: dict) -> str:
     head = (f"{result['arena']}: {result['robots']} robot(s), {result['strategy']}, "
             f"{result['world']} world, root {result['root']}")
     if not result["completed"]:
-        return f"{head}\nnot completed: no robot declared completion in time"
+        why = result.get("ended_because", "max time")
+        lines = [head, f"not completed ({why}): no robot declared completion"]
+        lines += [f"stopped: R{s['robot']} at {s['at_s']:.1f} s: {s['reason']}"
+                  for s in result.get("stopped_robots", [])]
+        return "\n".join(lines)
     per_robot = " ".join(f"R{i + 1}={n}" for i, n in enumerate(result["traversals_per_robot"]))
     verdict = "equal to" if result["map_correct"] else "DIFFERENT from"
     unit = "edges by one robot" if result["world"] == "embodied" else "steps"
@@ -159,6 +183,9 @@ def summary(result: dict) -> str:
             (f"collisions: {result['collisions']} robot-robot contact events; "
             f"speed changes (eq. 27): {result['speed_changes']}"),
         ]
+        lines += [f"stopped: R{s['robot']} at {s['at_s']:.1f} s: {s['reason']}"
+                  for s in result["stopped_robots"]]
+        lines += [f"fault: {f['fault']} at {f['at_s']:.1f} s" for f in result["faults"]]
         if result["radio_messages"] is not None:
             lines.append(
                 f"radio: {result['radio_messages']} messages (busiest robot "

@@ -1,0 +1,137 @@
+"""Fault injection for embodied exploration (``mjswarm explore --fault``, issue 13).
+
+Forms (times in simulated seconds; robots numbered from 1, as in every output):
+
+``robot:I@T``
+    Robot I fails at T: it stops where it is and stays there as an obstacle, its radio
+    goes silent, and it releases every vertex it holds (:mod:`mjswarm.stations`). The
+    edge it had selected stays *out* in the beacons it marked; seed 003's priority (4)
+    keeps out edges as the last candidates (``Eo``), so another robot takes it once the
+    unexplored edges run out: a dead robot's claim never needs to expire for the
+    exploration to finish. If its body blocks a lane or a vertex that others need, the
+    run ends ``stalled`` and says so.
+``beacon:V@T``
+    The beacon at vertex V is wiped at T (its contents and id are gone). The next robot
+    there drops a new beacon under a new id; robots that knew the old one keep both
+    names, so the maps may then hold a phantom vertex: the result's ``map_correct`` tells.
+``radio-blackout@T1-T2``
+    Every radio message sent from T1 up to T2 is lost (needs ``--radio-range``).
+
+Sensor noise and wheel slip are options of their own (``--line-noise``, ``--ir-noise``,
+``--wheel-slip``), passed to :class:`mjswarm.simulation.Simulation`.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from algorithms.exploration import Beacon
+from mjswarm.errors import MjswarmError
+
+if TYPE_CHECKING:  # the loop functions call faults; faults act on them
+    from mjswarm.embodied import EmbodiedExploration
+
+FORMS = ("robot:I@T", "beacon:V@T", "radio-blackout@T1-T2")
+_NUMBER = r"(\d+(?:\.\d*)?|\.\d+)"
+
+
+@dataclass(frozen=True)
+class RobotFailure:
+    """Robot ``robot`` (0-based) fails at ``at_s``."""
+
+    robot: int
+    at_s: float
+
+    def check(self, run: EmbodiedExploration) -> None:
+        if not 0 <= self.robot < len(run.minds):
+            raise MjswarmError(f"fault {self}: there are robots 1..{len(run.minds)}")
+
+    def apply(self, run: EmbodiedExploration) -> None:
+        run.dead[self.robot] = True
+        if not run.done[self.robot]:
+            run._stop(self.robot, f"failed (fault {self})")
+        if self.robot in run.launch_queue:  # not launched yet: it never will be
+            run.launch_queue.remove(self.robot)
+
+    def __str__(self) -> str:
+        return f"robot:{self.robot + 1}@{self.at_s:g}"
+
+
+@dataclass(frozen=True)
+class BeaconWipe:
+    """The beacon at ``vertex`` is wiped at ``at_s``."""
+
+    vertex: str
+    at_s: float
+
+    def check(self, run: EmbodiedExploration) -> None:
+        if self.vertex not in run.spec.vertices:
+            raise MjswarmError(f"fault {self}: {self.vertex!r} is not a vertex of {run.spec.name}")
+
+    def apply(self, run: EmbodiedExploration) -> None:
+        run.beacons[self.vertex] = Beacon()
+
+    def __str__(self) -> str:
+        return f"beacon:{self.vertex}@{self.at_s:g}"
+
+
+@dataclass(frozen=True)
+class RadioBlackout:
+    """No radio message gets through from ``at_s`` until ``end_s``."""
+
+    at_s: float
+    end_s: float
+
+    def check(self, run: EmbodiedExploration) -> None:
+        if self.end_s <= self.at_s:
+            raise MjswarmError(f"fault {self}: the blackout must end after it starts")
+        if run.awareness is None:
+            raise MjswarmError(f"fault {self} needs robots with radios (--radio-range)")
+
+    def apply(self, run: EmbodiedExploration) -> None:
+        run.awareness.radio.blackout = True
+        run.pending_faults.append(_BlackoutEnd(self.end_s))
+        run.pending_faults.sort(key=lambda f: f.at_s)
+
+    def __str__(self) -> str:
+        return f"radio-blackout@{self.at_s:g}-{self.end_s:g}"
+
+
+@dataclass(frozen=True)
+class _BlackoutEnd:
+    """The end of a :class:`RadioBlackout` (scheduled by it)."""
+
+    at_s: float
+
+    def apply(self, run: EmbodiedExploration) -> None:
+        run.awareness.radio.blackout = False
+
+    def __str__(self) -> str:
+        return f"radio back at {self.at_s:g}"
+
+
+Fault = RobotFailure | BeaconWipe | RadioBlackout
+
+_PATTERNS = (
+    (re.compile(rf"robot:(\d+)@{_NUMBER}"),
+     lambda m: RobotFailure(int(m[1]) - 1, float(m[2]))),
+    (re.compile(rf"beacon:([A-Za-z0-9_]+)@{_NUMBER}"),
+     lambda m: BeaconWipe(m[1], float(m[2]))),
+    (re.compile(rf"radio-blackout@{_NUMBER}-{_NUMBER}"),
+     lambda m: RadioBlackout(float(m[1]), float(m[2]))),
+)
+
+
+def parse_fault(text: str) -> Fault:
+    """One ``--fault`` value; :class:`MjswarmError` naming the forms if it is none of them."""
+    for pattern, build in _PATTERNS:
+        match = pattern.fullmatch(text.strip())
+        if match:
+            fault = build(match)
+            if isinstance(fault, RobotFailure) and fault.robot < 0:
+                raise MjswarmError(f"fault '{text}': robots are numbered from 1")
+            return fault
+    raise MjswarmError(f"bad fault '{text}': expected one of {', '.join(FORMS)} "
+                       "(times in simulated seconds)")

@@ -1,0 +1,108 @@
+"""Vertex entry (mjswarm.stations): holds, first-come grants, and no circular wait."""
+
+from __future__ import annotations
+
+import math
+
+import networkx as nx
+import numpy as np
+import pytest
+
+from mjswarm.arena import load_arena
+from mjswarm.stations import VertexStations
+
+
+@pytest.fixture
+def lattice():
+    return VertexStations(load_arena("lattice:3x3"))
+
+
+def test_edge_towards_names_the_neighbour_along_an_angle(lattice):
+    assert lattice.edge_towards("v1_1", 0.0) == ("v1_2", 0.0)
+    neighbour, off = lattice.edge_towards("v1_1", math.radians(95.0))
+    assert neighbour == "v2_1" and math.isclose(off, math.radians(5.0))
+
+
+def test_a_free_vertex_is_granted_and_held(lattice):
+    lattice.occupy(0, "v0_0")
+    lattice.request(0, "v0_0", "v0_1", 1.0)
+    assert lattice.grant() == [(0, "v0_1")]
+    assert lattice.holder == {"v0_0": 0, "v0_1": 0}
+    lattice.release(0, "v0_0")
+    assert lattice.holder == {"v0_1": 0}
+
+
+def test_a_held_vertex_waits_and_requests_are_served_in_order(lattice):
+    lattice.occupy(0, "v1_1")
+    lattice.occupy(1, "v0_1")
+    lattice.occupy(2, "v1_0")
+    lattice.request(2, "v1_0", "v1_1", 5.0)
+    lattice.request(1, "v0_1", "v1_1", 3.0)
+    assert lattice.grant() == []  # robot 0 stands on v1_1 and is not leaving
+    lattice.request(0, "v1_1", "v2_1", 6.0)
+    assert lattice.grant() == [(0, "v2_1")]
+    lattice.release(0, "v1_1")  # in its corridor
+    assert lattice.grant() == [(1, "v1_1")]  # asked first
+    assert lattice.requests.keys() == {2}
+
+
+def test_a_swap_along_one_edge_is_granted_to_both(lattice):
+    """Issue 13's deadlock, reduced: robots on both ends of an edge, each wanting the
+    other's vertex, would wait for ever; the stations let them pass on their lanes."""
+    lattice.occupy(0, "v0_0")
+    lattice.occupy(1, "v0_1")
+    lattice.request(0, "v0_0", "v0_1", 1.0)
+    lattice.request(1, "v0_1", "v0_0", 2.0)
+    assert sorted(lattice.grant()) == [(0, "v0_1"), (1, "v0_0")]
+    lattice.release(0, "v0_0")  # robot 1 holds it now: robot 0's release leaves it
+    assert lattice.holder == {"v0_1": 0, "v0_0": 1}
+
+
+def test_a_chain_that_does_not_close_waits(lattice):
+    lattice.occupy(0, "v0_0")
+    lattice.occupy(1, "v0_1")
+    lattice.occupy(2, "v0_2")
+    lattice.request(0, "v0_0", "v0_1", 1.0)
+    lattice.request(1, "v0_1", "v0_2", 1.0)
+    assert lattice.grant() == []  # robot 2 stands on v0_2 and asks for nothing
+
+
+def test_a_stopped_robot_releases_everything(lattice):
+    lattice.occupy(0, "v0_0")
+    lattice.request(0, "v0_0", "v0_1", 1.0)
+    lattice.grant()
+    assert sorted(lattice.release_all(0)) == ["v0_0", "v0_1"]
+    assert lattice.holder == {} and lattice.requests == {}
+
+
+def _wait_for_graph(stations: VertexStations) -> nx.DiGraph:
+    """Robot -> robot it waits for (the holder of the vertex it wants)."""
+    g = nx.DiGraph()
+    for robot, request in stations.requests.items():
+        holder = stations.holder.get(request.to)
+        if holder is not None:
+            g.add_edge(robot, holder)
+    return g
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_no_circular_wait_survives_a_grant(seed):
+    """Random teams on the centres of a lattice, each wanting a random neighbour: after
+    one grant no cycle of robots standing on centres waits for each other (networkx
+    finds none), and every grant respects one robot per vertex."""
+    spec = load_arena("lattice:4x4")
+    g = spec.graph()
+    rng = np.random.default_rng(seed)
+    vertices = list(spec.vertices)
+    team = rng.choice(len(vertices), size=rng.integers(2, 12), replace=False)
+    stations = VertexStations(spec)
+    for robot, k in enumerate(team):
+        stations.occupy(robot, vertices[k])
+    for robot, k in enumerate(team):
+        if rng.random() < 0.85:
+            nbrs = sorted(g.neighbors(vertices[k]))
+            stations.request(robot, vertices[k], nbrs[rng.integers(len(nbrs))], float(robot))
+    granted = stations.grant()
+    assert len({v for _, v in granted}) == len(granted)
+    assert all(stations.holder[v] == r for r, v in granted)
+    assert list(nx.simple_cycles(_wait_for_graph(stations))) == []
