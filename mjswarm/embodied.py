@@ -18,9 +18,12 @@ robots, records and measures. Choices it makes, beyond the paper:
   reads and writes the beacon only during its vertex call, i.e. while it stands on the
   vertex centre; the world finds which vertex that is from ground truth, as the station
   knew which vertex was calling.
-* **The speed rule applies on edges** (on a lane, seed 003 Sec. 4 "traversing an
+* **The speed rule applies on edges** (following a lane, seed 003 Sec. 4 "traversing an
   edge"); in the vertex area (turns, scans, the sidesteps between lane and vertex
-  centre) robots move at S and are kept apart by vertex entry. Applied at the vertex
+  centre, finding the lane) robots move at S and are kept apart by vertex entry. A robot
+  slowed by the rule while it leaves a vertex would keep that vertex's area occupied
+  (issue 13: a robot leaving ``v7`` of ``fig9`` at 3 mm/s, slowed for the robot that was
+  swapping vertices with it, was run into by it). Applied at the vertex
   centre too, the rule's "beta = 0: stop" would stop a robot facing a robot on the next
   vertex along its edge, which may be waiting to enter this vertex: a deadlock.
 * **Vertex entry** (our addition, needed once robots have bodies): a vertex area holds
@@ -312,6 +315,8 @@ class EmbodiedExploration:
                 if self.leaving[i] is not None and nav.in_corridor:  # clear of it
                     self.stations.release(i, self.leaving[i])
                     self.leaving[i] = None
+                if nav.at_vertex_area and self.target[i] in self.leaving:
+                    speed = 0.0  # its previous holder is still leaving (a cycle's grant)
             factor = speed / cfg.speed_m_s
             if vi != 0.0:  # translations run at the rule's speed; turns in place do not
                 vi, wi = vi * factor, wi * factor

@@ -166,12 +166,15 @@ class Navigator:
 
     @property
     def on_lane(self) -> bool:
-        """Driving along an edge on its lane: following it, or looking for it straight ahead
-        after leaving a vertex (the sidestep is done)."""
-        if self.state is NavigatorState.ON_EDGE:
-            return True
-        return (self.state is NavigatorState.LEAVING and bool(self._plan)
-                and isinstance(self._plan[0][0], SeekLine))
+        """Following an edge's lane (not yet arriving at the vertex at its end)."""
+        return self.state is NavigatorState.ON_EDGE
+
+    @property
+    def at_vertex_area(self) -> bool:
+        """About to enter a vertex area: on the lane with the vertex detected (the left
+        wall has ended), or already arriving."""
+        return ((self.state is NavigatorState.ON_EDGE and self.vertex_detected)
+                or self.state is NavigatorState.ARRIVING)
 
     # ---------------------------------------------------------------- plans
     def _shift(self, heading: float, side: int) -> list:
