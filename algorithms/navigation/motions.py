@@ -31,6 +31,8 @@ LINE_END_GAP_M = 0.02
 #: A strip's longitudinal end (see FollowLine) must hold for this many control ticks, so
 #: that one noisy reading does not end it.
 END_CONFIRM_TICKS = 2
+#: FollowSpoke holds its heading once the centre sensor alone has seen the spoke this far (m).
+SPOKE_ALIGN_M = 0.015
 
 
 def wrap(angle: float) -> float:
@@ -176,6 +178,67 @@ class FollowLine:
         if not recent:
             return fallback
         return math.atan2(sum(math.sin(h) for h in recent), sum(math.cos(h) for h in recent))
+
+
+@dataclass
+class FollowSpoke:
+    """Follow a vertex spoke to its inner end, where the robot's centre sensor leaves it.
+
+    Starts as :class:`FollowLine`; once the centre sensor alone has been on the strip
+    for ``SPOKE_ALIGN_M`` (the robot is aligned with it), the robot holds the spoke's
+    direction (the mean heading of those aligned ticks) and no longer steers by the side
+    sensors: where edges are 45 degrees apart the inner ends of neighbouring spokes
+    overlap, and a side sensor that reached one would steer the robot out along it
+    (issue 13; ``fan:3:45``). The spoke's centre line beyond its inner end crosses no
+    other spoke. It ends when the centre sensor leaves the strip (``END_CONFIRM_TICKS``
+    in a row); ``ended_at_m`` is then half-way between the last tick on and the first
+    off. ``direction`` is the held heading.
+    """
+
+    speed: float
+    ended_at_m: float | None = None
+    _follow: FollowLine | None = None
+    _aligned_since_m: float | None = None
+    _heading: float | None = None
+    _last_on_m: float = 0.0
+    _off_ticks: int = 0
+    _left_at_m: float = 0.0
+
+    def step(self, odo: Odometry, percept: Percept):
+        left, centre, right = percept.line
+        if self._heading is None:
+            if self._follow is None:
+                self._follow = FollowLine(self.speed)
+            command = self._follow.step(odo, percept)
+            if command is None:
+                self.ended_at_m = self._follow.ended_at_m
+                return None
+            if centre and not (left or right):
+                if self._aligned_since_m is None:
+                    self._aligned_since_m = odo.distance_m
+                if odo.distance_m - self._aligned_since_m >= SPOKE_ALIGN_M:
+                    self._heading = self._follow.direction(odo.theta, last=None)
+            else:
+                self._aligned_since_m = None
+            self._last_on_m = odo.distance_m
+            return command
+        if centre:
+            self._last_on_m, self._off_ticks = odo.distance_m, 0
+        else:
+            if self._off_ticks == 0:
+                self._left_at_m = (self._last_on_m + odo.distance_m) / 2.0
+            self._off_ticks += 1
+            if self._off_ticks >= END_CONFIRM_TICKS:
+                self.ended_at_m = self._left_at_m
+                return None
+        return self.speed, hold_heading(odo, self._heading)
+
+    def direction(self, fallback: float) -> float:
+        """The spoke's direction (rad, odometry frame): the held heading, else the
+        follower's estimate, else ``fallback``."""
+        if self._heading is not None:
+            return self._heading
+        return fallback if self._follow is None else self._follow.direction(fallback)
 
 
 @dataclass

@@ -14,10 +14,10 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
 * **arriving**: shift right by ``lane_offset_m`` onto the centre line (turn 60 degrees,
   drive, turn back), find and follow the incoming spoke to its inner end, drive
   ``line_ahead_m + spoke_inner_radius_m`` to stand on the vertex centre. The approach
-  runs at most at ``APPROACH_SPEED_M_S`` whatever the cruising speed, and the spoke's
-  end is its longitudinal end (:class:`~.motions.FollowLine`), so a neighbouring spoke's
-  inner end, within a side sensor's reach when edges are 45-90 degrees apart, cannot
-  carry the robot away (issue 13);
+  runs at most at ``APPROACH_SPEED_M_S`` whatever the cruising speed, and once aligned
+  with the spoke the robot holds its direction and watches only the centre sensor
+  (:class:`~.motions.FollowSpoke`), so a neighbouring spoke's inner end, within a side
+  sensor's reach when edges are 45-90 degrees apart, cannot carry it away (issue 13);
 * **discovering edges**: rotate once in place (:class:`~.motions.Scan`); every spoke
   crossed gives an incidence angle, measured with encoder odometry. The spoke the robot
   came by lies opposite the lane's direction (measured on the lane, in the odometry
@@ -48,7 +48,15 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import Enum
 
-from algorithms.navigation.motions import Drive, FollowLine, Scan, SeekLine, Turn, wrap
+from algorithms.navigation.motions import (
+    Drive,
+    FollowLine,
+    FollowSpoke,
+    Scan,
+    SeekLine,
+    Turn,
+    wrap,
+)
 from algorithms.navigation.odometry import Odometry, RobotCalibration
 from algorithms.navigation.percept import Percept
 
@@ -228,14 +236,14 @@ class Navigator:
         self._plan = deque([
             *self._shift(heading, -1),
             (SeekLine(heading, self._approach_speed, self.conv.max_seek_m), self._found_spoke),
-            (FollowLine(self._approach_speed), self._spoke_ended),
+            (FollowSpoke(self._approach_speed), self._spoke_ended),
         ])
 
     def _found_spoke(self, seek: SeekLine) -> None:
         if seek.failed:
             self._lose("no spoke found at the vertex")
 
-    def _spoke_ended(self, spoke: FollowLine) -> None:
+    def _spoke_ended(self, spoke: FollowSpoke) -> None:
         """The sensor passed the spoke's inner end: the centre is ``line_ahead +
         spoke_inner_radius`` beyond where the axle was then."""
         heading = spoke.direction(self.odometry.theta)

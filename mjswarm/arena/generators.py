@@ -27,6 +27,37 @@ Every generator is a deterministic function of its arguments (randomness from
 
 ``random-tree:E:SEED``
     ``random-graph:(E+1):E:SEED``: a random tree with E edges on the lattice.
+
+Generators beyond the square lattice (vertices whose edges are 45 to 120 degrees apart,
+for issue 13's stress grid). Where a length has a default it is the smallest multiple of
+``DEFAULT_STEP_M`` for which every rule of :mod:`mjswarm.arena.spec` holds, found by
+asking the validator, not by a formula:
+
+``fan:N:DEG[:LEN]``
+    A star: centre ``c`` with N edges DEG degrees apart (the first along +x) to leaves
+    ``l0``, ``l1``, ... LEN metres out (default: the smallest valid). Root ``l0``, so the
+    robots reach the acute vertex along an edge.
+``wheel:N[:R]``
+    N rim vertices ``r0``.. at radius R metres (default: the smallest valid) around a
+    centre ``c``: spokes ``c``-``ri`` and rim edges ``ri``-``r(i+1)``. N from 4 (45 degrees
+    at the rim) to 8 (45 degrees at the centre). Root ``r0``.
+``hex:RxC[:SPACING]``
+    A honeycomb of R by C hexagons (:func:`networkx.hexagonal_lattice_graph`), edges
+    SPACING metres long (default 0.6), 120 degrees apart; vertices ``v<i>_<j>``, root the
+    first vertex networkx lists.
+``tri:RxC[:SPACING]``
+    A triangular lattice (:func:`networkx.triangular_lattice_graph`: R rows, C
+    triangles a row), 60 degrees between edges, SPACING metres (default: the smallest
+    valid). Root ``v0_0``.
+``random-planar:V:SEED``
+    A random connected planar graph with arbitrary angles: V points drawn in a square by
+    rejection (at least the validator's shortest edge apart), their Delaunay
+    triangulation (:class:`scipy.spatial.Delaunay`), then edges dropped in a seeded order
+    while the validator rejects the graph and the edge it names can go without
+    disconnecting it. Root ``v0``.
+
+Any arena name may end in ``@DEG`` to rotate it by DEG degrees counter-clockwise about its
+root (:func:`rotated`, applied by :func:`mjswarm.arena.load_arena`).
 """
 
 from __future__ import annotations
@@ -36,6 +67,9 @@ import re
 
 import networkx as nx
 import numpy as np
+from scipy.spatial import Delaunay
+
+from mjswarm.arena import geometry
 
 from mjswarm.arena.spec import ArenaSpec
 from mjswarm.errors import MjswarmError
@@ -48,13 +82,27 @@ GENERATORS = {
     "lattice": "lattice:RxC[:SPACING]",
     "random-tree": "random-tree:E:SEED",
     "random-graph": "random-graph:V:E:SEED",
+    "fan": "fan:N:DEG[:LEN]",
+    "wheel": "wheel:N[:R]",
+    "hex": "hex:RxC[:SPACING]",
+    "tri": "tri:RxC[:SPACING]",
+    "random-planar": "random-planar:V:SEED",
 }
 
+_NUMBER = r"(\d+(?:\.\d*)?|\.\d+)"
 _PATTERNS = {
     "lattice": re.compile(r"lattice:(\d+)x(\d+)(?::([^:]+))?"),
     "random-tree": re.compile(r"random-tree:(\d+):(\d+)"),
     "random-graph": re.compile(r"random-graph:(\d+):(\d+):(\d+)"),
+    "fan": re.compile(rf"fan:(\d+):{_NUMBER}(?::{_NUMBER})?"),
+    "wheel": re.compile(rf"wheel:(\d+)(?::{_NUMBER})?"),
+    "hex": re.compile(rf"hex:(\d+)x(\d+)(?::{_NUMBER})?"),
+    "tri": re.compile(rf"tri:(\d+)x(\d+)(?::{_NUMBER})?"),
+    "random-planar": re.compile(r"random-planar:(\d+):(\d+)"),
 }
+#: Step (m) of the searches for the smallest valid default length, and their limit.
+DEFAULT_STEP_M = 0.05
+_LONGEST_DEFAULT_M = 5.0
 _NEIGHBOURS = ((1, 0), (-1, 0), (0, 1), (0, -1))
 #: Compactness exponents tried by the Eden growth before the compact fallback.
 _COMPACTNESS = (0, 1, 2, 4, 8)
@@ -87,8 +135,19 @@ def generate(text: str) -> ArenaSpec:
     if kind == "random-tree":
         edges, seed = map(int, match.groups())
         return random_tree(edges, seed)
-    vertices, edges, seed = map(int, match.groups())
-    return random_graph(vertices, edges, seed)
+    if kind == "random-graph":
+        vertices, edges, seed = map(int, match.groups())
+        return random_graph(vertices, edges, seed)
+    if kind == "random-planar":
+        vertices, seed = map(int, match.groups())
+        return random_planar(vertices, seed)
+    *counts, length = match.groups()
+    length = None if length is None else float(length)
+    if kind == "fan":
+        return fan(int(counts[0]), float(counts[1]), length)
+    if kind == "wheel":
+        return wheel(int(counts[0]), length)
+    return (hex_lattice if kind == "hex" else tri_lattice)(int(counts[0]), int(counts[1]), length)
 
 
 def lattice(rows: int, cols: int, spacing: float = LATTICE_SPACING_M) -> ArenaSpec:
@@ -225,3 +284,158 @@ def _eden_growth(n: int, compactness: float, rng: np.random.Generator) -> list[t
         occupied.add(cell)
         cells.append(cell)
     return cells
+
+
+# ---------------------------------------------------------------- beyond the square lattice
+
+
+def fan(n: int, degrees: float, length: float | None = None) -> ArenaSpec:
+    """A star of ``n`` edges ``degrees`` apart (see the module docstring)."""
+    text = f"fan:{n}:{degrees:g}" + ("" if length is None else f":{length:g}")
+    last_gap = 360.0 - (n - 1) * degrees
+    if n < 2 or degrees < geometry.MIN_ANGLE_DEG or last_gap < geometry.MIN_ANGLE_DEG - 1e-9:
+        raise MjswarmError(f"{text}: needs N >= 2 edges at least {geometry.MIN_ANGLE_DEG:g} "
+                           "degrees apart all round (DEG >= 45 and 360 - (N-1) DEG >= 45)")
+
+    def build(r: float) -> ArenaSpec:
+        leaves = {f"l{k}": _polar(r, math.radians(k * degrees)) for k in range(n)}
+        return ArenaSpec(text, "l0", {"c": (0.0, 0.0), **leaves},
+                         [("c", leaf) for leaf in leaves],
+                         f"{n} edges {degrees:g} degrees apart from centre c, {r:g} m long",
+                         text)
+
+    return _with_length(text, build, length)
+
+
+def wheel(n: int, radius: float | None = None) -> ArenaSpec:
+    """A rim of ``n`` vertices with spokes to a centre (see the module docstring)."""
+    text = f"wheel:{n}" + ("" if radius is None else f":{radius:g}")
+    if not 4 <= n <= 8:
+        raise MjswarmError(f"{text}: N must be 4..8 (rim angles (N-2) 90/N degrees and "
+                           "centre angles 360/N degrees must be at least 45)")
+
+    def build(r: float) -> ArenaSpec:
+        rim = {f"r{k}": _polar(r, 2 * math.pi * k / n) for k in range(n)}
+        edges = [("c", f"r{k}") for k in range(n)] + [(f"r{k}", f"r{(k + 1) % n}")
+                                                     for k in range(n)]
+        return ArenaSpec(text, "r0", {"c": (0.0, 0.0), **rim}, edges,
+                         f"wheel: {n} rim vertices at {r:g} m around centre c", text)
+
+    return _with_length(text, build, radius)
+
+
+def hex_lattice(rows: int, cols: int, spacing: float | None = None) -> ArenaSpec:
+    """A honeycomb of ``rows`` x ``cols`` hexagons (see the module docstring)."""
+    text = f"hex:{rows}x{cols}" + ("" if spacing is None else f":{spacing:g}")
+    if rows < 1 or cols < 1:
+        raise MjswarmError(f"{text}: needs R, C >= 1 hexagons")
+    graph = nx.hexagonal_lattice_graph(rows, cols, with_positions=True)
+    return _networkx_arena(text, graph, LATTICE_SPACING_M if spacing is None else spacing,
+                           "honeycomb lattice")
+
+
+def tri_lattice(rows: int, cols: int, spacing: float | None = None) -> ArenaSpec:
+    """A triangular lattice (see the module docstring)."""
+    text = f"tri:{rows}x{cols}" + ("" if spacing is None else f":{spacing:g}")
+    if rows < 1 or cols < 1:
+        raise MjswarmError(f"{text}: needs R, C >= 1")
+    graph = nx.triangular_lattice_graph(rows, cols, with_positions=True)
+    return _with_length(text, lambda d: _networkx_arena(text, graph, d, "triangular lattice"),
+                        spacing)
+
+
+def random_planar(n_vertices: int, seed: int) -> ArenaSpec:
+    """A random planar graph with arbitrary angles (see the module docstring)."""
+    text = f"random-planar:{n_vertices}:{seed}"
+    if n_vertices < 3:
+        raise MjswarmError(f"{text}: needs at least 3 vertices")
+    rng = np.random.default_rng(seed)
+    for _ in range(_PLANAR_TRIES):
+        spec = _pruned_delaunay(text, n_vertices, seed, rng)
+        if spec is not None:
+            return spec
+    raise MjswarmError(f"{text}: no valid arena in {_PLANAR_TRIES} point sets")
+
+
+def _pruned_delaunay(text: str, n: int, seed: int, rng: np.random.Generator):
+    """One try of :func:`random_planar`: None if pruning would disconnect the graph."""
+    gap = 1.5 * geometry.MIN_EDGE_LENGTH_M
+    side = gap * math.sqrt(2.0 * n)
+    points: list[np.ndarray] = []
+    while len(points) < n:
+        p = rng.uniform(0.0, side, 2)
+        if all(np.linalg.norm(p - q) >= gap for q in points):
+            points.append(p)
+    pts = np.round(np.array(points) - points[0], 4)
+    triangles = Delaunay(pts).simplices
+    pairs = sorted({tuple(sorted((int(a), int(b)))) for t in triangles
+                    for a, b in ((t[0], t[1]), (t[1], t[2]), (t[0], t[2]))})
+    edges = [(f"v{pairs[k][0]}", f"v{pairs[k][1]}") for k in rng.permutation(len(pairs))]
+    vertices = {f"v{k}": (float(x), float(y)) for k, (x, y) in enumerate(pts)}
+    while True:
+        try:
+            return ArenaSpec(text, "v0", vertices, edges,
+                             f"random planar graph, {n} vertices, seed {seed}", text)
+        except MjswarmError as exc:
+            drop = _removable_edge(str(exc), edges)
+            if drop is None:
+                return None
+            edges.pop(drop)
+
+
+def rotated(spec: ArenaSpec, degrees: float, text: str) -> ArenaSpec:
+    """``spec`` rotated by ``degrees`` counter-clockwise about its root, named ``text``."""
+    cx, cy = spec.vertices[spec.root]
+    c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+    vertices = {v: (round(cx + c * (x - cx) - s * (y - cy), 9),
+                    round(cy + s * (x - cx) + c * (y - cy), 9))
+                for v, (x, y) in spec.vertices.items()}
+    return ArenaSpec(text, spec.root, vertices, spec.edges,
+                     f"{spec.description} (rotated {degrees:g} degrees about {spec.root})", text)
+
+
+def _polar(r: float, angle: float) -> tuple[float, float]:
+    return (round(r * math.cos(angle), 9), round(r * math.sin(angle), 9))
+
+
+def _with_length(text: str, build, length: float | None) -> ArenaSpec:
+    """``build(length)``, or with the smallest valid multiple of DEFAULT_STEP_M."""
+    if length is not None:
+        if not (math.isfinite(length) and length > 0):
+            raise MjswarmError(f"{text}: lengths must be positive numbers of metres")
+        return build(length)
+    for k in range(1, round(_LONGEST_DEFAULT_M / DEFAULT_STEP_M) + 1):
+        try:
+            return build(round(k * DEFAULT_STEP_M, 9))
+        except MjswarmError:
+            continue
+    raise MjswarmError(f"{text}: no length up to {_LONGEST_DEFAULT_M:g} m makes a valid arena")
+
+
+def _networkx_arena(text: str, graph: nx.Graph, spacing: float, kind: str) -> ArenaSpec:
+    """A networkx lattice with unit edges and ``pos`` attributes, scaled to ``spacing``."""
+    if not (math.isfinite(spacing) and spacing > 0):
+        raise MjswarmError(f"{text}: SPACING must be a positive number of metres")
+    name = {node: f"v{node[0]}_{node[1]}" for node in graph}
+    vertices = {name[node]: (round(x * spacing, 9), round(y * spacing, 9))
+                for node, (x, y) in sorted(graph.nodes(data="pos"))}
+    edges = sorted((name[a], name[b]) if a < b else (name[b], name[a]) for a, b in graph.edges)
+    return ArenaSpec(text, next(iter(vertices)), vertices, edges,
+                     f"{kind}, edges {spacing:g} m", text)
+
+
+_VERTEX_IN_MESSAGE = re.compile(r"\bv\d+\b")
+#: Point sets :func:`random_planar` tries before it gives up.
+_PLANAR_TRIES = 50
+
+
+def _removable_edge(message: str, edges: list[tuple[str, str]]) -> int | None:
+    """Index of an edge to drop after the validator's ``message``: one it names (the
+    last first), else one at a vertex it names, that is no bridge; None if every
+    candidate is one."""
+    named = _VERTEX_IN_MESSAGE.findall(message)
+    pairs = [set(p) for p in zip(named, named[1:])]
+    bridges = {frozenset(e) for e in nx.bridges(nx.Graph(edges))}
+    candidates = [k for p in reversed(pairs) for k, e in enumerate(edges) if set(e) == p]
+    candidates += [k for k, e in enumerate(edges) if set(e) & set(named)]
+    return next((k for k in candidates if frozenset(edges[k]) not in bridges), None)

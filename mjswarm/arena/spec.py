@@ -45,6 +45,8 @@ _REQUIRED_KEYS = ("name", "root", "vertices", "edges")
 _OPTIONAL_KEYS = ("description",)
 _VERTEX_ID = re.compile(r"[A-Za-z0-9_]+")
 _SHIPPED_NAME = re.compile(r"[A-Za-z0-9_-]+")
+#: ``ARENA@DEG``: a rotation in degrees (counter-clockwise, about the root)
+_ROTATION = re.compile(r"-?(\d+(\.\d*)?|\.\d+)")
 
 
 @dataclass(frozen=True)
@@ -134,16 +136,19 @@ def shipped_arenas() -> list[str]:
 def load_arena(arena: str | os.PathLike) -> ArenaSpec:
     """Load an arena from a shipped name, a ``.json``/``.toml`` path, or a generator string.
 
-    Generators (see :mod:`mjswarm.arena.generators`): ``lattice:RxC[:SPACING]``,
-    ``random-tree:E:SEED``, ``random-graph:V:E:SEED``. A string is a generator if the
-    text before its first ``:`` names one; otherwise a path if it has a suffix or a
-    ``/``; otherwise a shipped name.
+    Generators: see :mod:`mjswarm.arena.generators`. A string is a generator if the text
+    before its first ``:`` names one; otherwise a path if it has a suffix or a ``/``;
+    otherwise a shipped name. Any of them may end in ``@DEG``: the arena rotated by DEG
+    degrees counter-clockwise about its root.
     """
     # Imported here: the generators build ArenaSpecs, so they import this module.
-    from mjswarm.arena.generators import GENERATORS, generate
+    from mjswarm.arena.generators import GENERATORS, generate, rotated
 
     text = os.fspath(arena)
     if not isinstance(arena, os.PathLike):
+        base, at, degrees = text.rpartition("@")
+        if at and _ROTATION.fullmatch(degrees):
+            return rotated(load_arena(base), float(degrees), text)
         kind, sep, _ = text.partition(":")
         if sep and kind in GENERATORS:
             return generate(text)

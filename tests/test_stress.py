@@ -1,0 +1,44 @@
+"""Issue 13's robustness stress grid (mjswarm.stress): a fast representative of each
+failure class by default, the whole grid with ``-m slow``."""
+
+from __future__ import annotations
+
+import pytest
+
+from mjswarm.stress import StressRun, grid, passed, run_grid, table
+
+
+@pytest.mark.parametrize("run", [
+    # 1. a vertex with edges 67.5 degrees apart: the approach was captured by a
+    #    neighbouring spoke's inner end
+    StressRun("issue13-fan", 1, 0.05, 0),
+    # 1. the validator's minimum, 45 degrees, at the top speed
+    StressRun("fan:3:45@17", 1, 0.2, 0),
+    # 2. 0.15 m/s: the speed rule's sudden stop pitched the body onto a phantom lane
+    StressRun("fig9", 2, 0.15, 0),
+    # 3. robots waiting on vertex centres stopped others by the speed rule for ever
+    StressRun("arena2", 4, 0.2, 1),
+], ids=str)
+def test_failure_class_representatives(run):
+    result = run.run(max_sim_time_s=1200.0)
+    assert passed(result), (result.ended_because, result.collisions, result.stopped_robots)
+    assert result.ended_because == "completed"
+
+
+def test_grid_leaves_out_teams_larger_than_the_arena():
+    runs = grid(arenas=("issue13-fan",), speeds=(0.1,), teams=(1, 4, 10))
+    assert [r.robots for r in runs] == [1]  # 3 edges
+
+
+def test_table_counts_what_it_ran():
+    rows = run_grid([StressRun("issue13-fan", 1, 0.2, 0)], workers=1)
+    text = table(rows)
+    assert "| `issue13-fan` | 1 | 1 | 1 | 0 | 0 |" in text
+
+
+@pytest.mark.slow
+def test_the_whole_grid_passes():
+    rows = run_grid(grid(), workers=2)
+    failures = [(r, res.ended_because, res.collisions, res.stopped_robots)
+                for r, res, _ in rows if not passed(res)]
+    assert failures == []
