@@ -48,7 +48,7 @@ class StressRun:
     arena: str
     robots: int
     speed_m_s: float
-    seed: int
+    seed: int | None
 
     def spec(self) -> ArenaSpec:
         if self.arena == ISSUE_13_FAN["name"]:

@@ -12,7 +12,9 @@ from mjswarm.cli.output import write_json
 _ARENA_HELP = (
     "a shipped arena ({shipped}), a .json/.toml spec file, or a generator: "
     "lattice:RxC[:SPACING] (R rows, C columns, SPACING in m, default 0.6), "
-    "random-tree:E:SEED, random-graph:V:E:SEED"
+    "random-tree:E:SEED, random-graph:V:E:SEED, fan:N:DEG[:LEN], wheel:N[:R], "
+    "hex:RxC[:SPACING], tri:RxC[:SPACING], random-planar:V:SEED; append @DEG to rotate "
+    "the arena about its root"
 )
 
 

@@ -87,7 +87,9 @@ def register(subparsers) -> None:
     parser.add_argument("--arena", required=True, metavar="ARENA",
                         help="shipped arena name (e.g. fig9, tree1, arena2), path to a "
                              ".json/.toml spec, or generator (lattice:RxC, "
-                             "random-tree:E:SEED, random-graph:V:E:SEED)")
+                             "random-tree:E:SEED, random-graph:V:E:SEED, fan:N:DEG, wheel:N, "
+                             "hex:RxC, tri:RxC, random-planar:V:SEED); append @DEG to rotate "
+                             "it about its root")
     parser.add_argument("--robots", type=int, required=True, metavar="K",
                         help="number of robots, all starting at the root")
     parser.add_argument("--strategy", default="incidence-dfs", metavar="NAME",
