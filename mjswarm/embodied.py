@@ -58,6 +58,7 @@ robots, records and measures. Choices it makes, beyond the paper:
 from __future__ import annotations
 
 import math
+import sys
 import time
 from dataclasses import dataclass, field
 
@@ -94,6 +95,8 @@ DEPARTURE_TOLERANCE_RAD = math.radians(22.5)
 #: the time to drive the longest edge at the run's speed.
 STALL_MIN_S = 300.0
 STALL_EDGE_FACTOR = 10.0
+#: Wall seconds between status lines when progress goes to a log, not a terminal.
+STATUS_EVERY_S = 30.0
 
 
 @dataclass
@@ -235,6 +238,7 @@ class EmbodiedExploration:
         self.last_progress_s = 0.0
         self.declared: tuple[float, int, str] | None = None
         self.stopped: list[dict] = []
+        self._last_speed = [config.speed_m_s] * k  # for the recording's speed-change events
         self.heading_error_rad = 0.0
         self.pending_faults = sorted(config.faults, key=lambda f: f.at_s)
         self.fault_log: list[dict] = []
@@ -254,11 +258,18 @@ class EmbodiedExploration:
 
     # ------------------------------------------------------------------ loop
     def run(self, progress: bool = False) -> EmbodiedResult:
+        """Step until the run is over (:meth:`finished`) or ``max_sim_time_s``.
+
+        ``progress``: on a terminal, a bar of simulated seconds (there is no honest total:
+        a run ends when a robot declares completion) with the edge traversals so far;
+        elsewhere (logs, CI) a status line on stderr every ``STATUS_EVERY_S`` of wall
+        time and one at the end."""
         cfg = self.config
-        start = time.perf_counter()
+        start = last_status = time.perf_counter()
         ticks = int(cfg.max_sim_time_s / self.sim.control_dt_s)
-        bar = tqdm(total=round(cfg.max_sim_time_s), unit="sim s", disable=not progress,
-                   desc=f"explore {self.spec.name}", leave=False)
+        bar = tqdm(unit="sim s", desc=f"explore {self.spec.name}", leave=False,
+                   disable=not (progress and sys.stderr.isatty()))
+        log = progress and bar.disable
         shown = 0
         for _ in range(ticks):
             self.step()
@@ -268,9 +279,25 @@ class EmbodiedExploration:
             if now > shown:
                 bar.update(now - shown)
                 shown = now
-                bar.set_postfix(edges=sum(len(p) - 1 for p in self.paths))
+                bar.set_postfix(edges=self._traversals(), refresh=False)
+            if log and time.perf_counter() - last_status >= STATUS_EVERY_S:
+                last_status = time.perf_counter()
+                print(self._status(last_status - start), file=sys.stderr, flush=True)
         bar.close()
+        self._event(None, f"run ended: {self.ended_because}")
+        if log:
+            print(self._status(time.perf_counter() - start), file=sys.stderr, flush=True)
         return self.result(time.perf_counter() - start)
+
+    def _traversals(self) -> int:
+        return sum(len(p) - 1 for p in self.paths)
+
+    def _status(self, wall_s: float) -> str:
+        """One line for logs: where the run is."""
+        return (f"explore {self.spec.name}: {self.sim.time_s:.0f} s simulated in "
+                f"{wall_s:.0f} s, {self._traversals()} edge traversals, "
+                f"{sum(self.active)} of {len(self.active)} robots launched, "
+                f"{len(self.stopped)} stopped")
 
     def finished(self) -> bool:
         """Whether the run is over (and why, in ``ended_because``)."""
@@ -317,6 +344,9 @@ class EmbodiedExploration:
                     self.leaving[i] = None
                 if nav.at_vertex_area and self.target[i] in self.leaving:
                     speed = 0.0  # its previous holder is still leaving (a cycle's grant)
+            if speed != self._last_speed[i] and nav.on_lane:
+                self._event(i, f"R{i + 1} speed {self._last_speed[i]:.3f} -> {speed:.3f} m/s")
+            self._last_speed[i] = speed
             factor = speed / cfg.speed_m_s
             if vi != 0.0:  # translations run at the rule's speed; turns in place do not
                 vi, wi = vi * factor, wi * factor
@@ -326,10 +356,12 @@ class EmbodiedExploration:
         if self.awareness is not None:
             self._radio_tick()
         if self.recorder is not None:
-            self.recorder.log_tick(sim.step_count, sim.time_s, sim.poses(),
-                                   sim.readings()["line"], sim.readings()["ir"], speeds,
+            readings = sim.readings()
+            self.recorder.log_tick(sim.step_count, sim.time_s, sim.poses(), readings["line"],
+                                   readings["ir"], speeds,
                                    [list(b.items()) for b in bearings] if bearings else
-                                   [[] for _ in range(sim.n)])
+                                   [[] for _ in range(sim.n)],
+                                   readings["encoder"], readings["battery"])
 
     # ------------------------------------------------------------------ robots
     def _radio_tick(self) -> None:
@@ -421,6 +453,7 @@ class EmbodiedExploration:
             self.declared = (self.sim.time_s, i, vertex)
             self.done[i] = True
             self._event(i, f"R{i + 1} declares completion at {vertex}")
+            self._event(None, f"R{i + 1} declared completion at {vertex}")
         else:
             raise ValueError(f"robot {i + 1} answered an unknown decision {decision!r}")
 

@@ -13,20 +13,26 @@ is right-handed, z up, the floor at z = 0)::
     arena/strips              Boxes3D, static: lane strips and vertex spokes
     arena/walls               Boxes3D, static: corridor walls
     arena/vertices            Points3D, static: vertex centres labelled with arena ids
-    robots/r<i>/pose          Transform3D per tick (x, y, yaw) + static Cylinders3D body
-    robots/r<i>/pose/heading  Arrows3D, static, in the robot frame: the heading
-    robots/r<i>/trail         LineStrips3D per tick: the segment driven since the last tick
-    robots/r<i>/speed         Scalars per tick: commanded linear speed
-    robots/r<i>/sensors/line  Scalars per tick, 3 series: line rangefinders (left, centre, right)
-    robots/r<i>/sensors/ir    Scalars per tick, 3 series: IR distances, NaN = nothing seen
-    robots/r<i>/bearings/r<j> Scalars (drawn as points) at ticks where r<i> sees r<j>
-    map/r<i>                  GraphNodes + GraphEdges: robot i's explored graph
+    robots/R<k>/pose          Transform3D per tick (x, y, yaw) + static Cylinders3D body
+    robots/R<k>/pose/heading  Arrows3D, static, in the robot frame: the heading
+    robots/R<k>/trail         LineStrips3D per tick: the segment driven since the last tick
+    robots/R<k>/speed         Scalars per tick: commanded linear speed
+    robots/R<k>/sensors/line  Scalars per tick, 3 series: line rangefinders (left, centre, right)
+    robots/R<k>/sensors/ir    Scalars per tick, 3 series: IR distances, NaN = nothing seen
+    robots/R<k>/sensors/encoders  Scalars per tick, 2 series: wheel angles (rad)
+    robots/R<k>/battery       Scalars per tick: battery terminal voltage (V)
+    robots/R<k>/bearings/R<j> Scalars (drawn as points) at ticks where R<k> sees R<j>
+    map/R<k>                  GraphNodes + GraphEdges: robot R<k>'s explored graph
     beacons/<vertex>          TextDocument: the beacon's contents (beacon-side vertex id)
     radio/graph               GraphNodes + GraphEdges: who hears whom
     radio/links               LineStrips3D: the same edges drawn between the robots
     radio/truth               TextDocument: ground truth and the robots' beliefs
-    events                    TextLog: run-wide events (completion, ...)
-    events/r<i>               TextLog: robot i's events (vertex visits, speed changes)
+    events                    TextLog: run-wide events (launches of faults, completion, the end)
+    events/R<k>               TextLog: robot R<k>'s events (vertex visits, speed changes, stops)
+
+Robots are numbered from 1, R1..RK, as everywhere a user sees them (the CLI, JSON,
+``--launch-order``); the methods take 0-based indices (robot ``i`` is ``R{i+1}``).
+The blueprint shows the radio views only for runs with radios (``radio=True``).
 
 Everything not static is on two timelines: ``step`` (control tick, a sequence) and
 ``sim_time`` (simulated seconds, a duration). The SDK's own ``log_tick``/``log_time``
@@ -68,7 +74,7 @@ import rerun.blueprint as rrb
 from mjswarm.arena.builder import arena_primitives
 from mjswarm.arena.spec import ArenaSpec
 from mjswarm.errors import MjswarmError, one_line
-from mjswarm.robot import IR_SENSORS, LINE_SENSORS
+from mjswarm.robot import ENCODERS, IR_SENSORS, LINE_SENSORS
 
 if TYPE_CHECKING:
     from typing_extensions import Self
@@ -92,6 +98,11 @@ _ROOT_COLOR = (240, 190, 20, 255)
 _AGREE_COLOR = (40, 170, 60, 255)
 _DISAGREE_COLOR = (220, 40, 40, 255)
 _NO_BELIEF_COLOR = (140, 140, 140, 255)
+
+
+def robot_name(i: int) -> str:
+    """The name users see for 0-based robot index ``i``: R1, R2, ..."""
+    return f"R{i + 1}"
 
 
 def robot_color(i: int) -> tuple[int, int, int, int]:
@@ -176,10 +187,11 @@ class Recorder:
     Args:
         path: the ``.rrd`` file to write (its directory must exist).
         arena: the arena the run happens in (drawn as static data).
-        n_robots: team size; robots are ``r0 .. r{n-1}``.
+        n_robots: team size; robots are R1..RK (indices 0..K-1 in the methods).
         robot_radius_m: body radius for drawing (m).
         chunk_ticks: ticks buffered between columnar sends.
         trail_window_s: simulated seconds of trail the blueprint shows.
+        radio: whether the run has radios (the blueprint then shows the radio views).
 
     Raises :class:`MjswarmError` (one line) if the file cannot be created or a
     parameter is impossible. Use as a context manager or call :meth:`close`.
@@ -194,6 +206,7 @@ class Recorder:
         *,
         chunk_ticks: int = CHUNK_TICKS,
         trail_window_s: float = TRAIL_WINDOW_S,
+        radio: bool = False,
     ) -> None:
         if int(n_robots) != n_robots or n_robots < 1:
             raise MjswarmError(f"a recording needs at least 1 robot, got {n_robots}")
@@ -220,7 +233,7 @@ class Recorder:
         self._stream.set_log_tick_enabled(False)
         self._stream.set_log_time_enabled(False)
         self._stream.send_recording_name(f"{arena.name}, {n} robots")
-        self._stream.send_blueprint(_blueprint(arena, n, trail_window_s))
+        self._stream.send_blueprint(_blueprint(arena, n, trail_window_s, radio))
         self._closed = False
 
         b = self._chunk
@@ -231,6 +244,8 @@ class Recorder:
         self._line = np.zeros((b, n, 3))
         self._ir = np.zeros((b, n, 3))
         self._speed = np.zeros((b, n))
+        self._encoders = np.zeros((b, n, 2))
+        self._battery = np.zeros((b, n))
         self._bearing_rows: list[int] = []
         self._bearing_pairs: list[int] = []  # observer * n + other
         self._bearing_values: list[float] = []
@@ -263,20 +278,23 @@ class Recorder:
         ), static=True)
         for i in range(self.n_robots):
             color = robot_color(i)
-            log(f"robots/r{i}/pose", rr.Cylinders3D(
+            log(f"robots/{robot_name(i)}/pose", rr.Cylinders3D(
                 lengths=ROBOT_HEIGHT_M, radii=radius_m, centers=(0.0, 0.0, ROBOT_HEIGHT_M / 2),
-                colors=color, labels=f"r{i}", fill_mode="solid",
+                colors=color, labels=robot_name(i), fill_mode="solid",
             ), static=True)
-            log(f"robots/r{i}/pose/heading", rr.Arrows3D(
+            log(f"robots/{robot_name(i)}/pose/heading", rr.Arrows3D(
                 origins=(0.0, 0.0, ROBOT_HEIGHT_M + 0.005), vectors=(1.5 * radius_m, 0.0, 0.0),
                 colors=(255, 255, 255, 255), radii=0.006,
             ), static=True)
-            log(f"robots/r{i}/trail", rr.LineStrips3D.from_fields(colors=color, radii=0.004),
+            name = robot_name(i)
+            log(f"robots/{name}/trail", rr.LineStrips3D.from_fields(colors=color, radii=0.004),
                 static=True)  # style only: static strips would hide the temporal ones
-            log(f"robots/r{i}/speed", rr.SeriesLines(names=f"r{i}", colors=color), static=True)
-            for kind, names in (("line", LINE_SENSORS), ("ir", IR_SENSORS)):
-                log(f"robots/r{i}/sensors/{kind}",
-                    rr.SeriesLines(names=[f"r{i} {s}" for s in names]), static=True)
+            log(f"robots/{name}/speed", rr.SeriesLines(names=name, colors=color), static=True)
+            log(f"robots/{name}/battery", rr.SeriesLines(names=name, colors=color), static=True)
+            for kind, names in (("line", LINE_SENSORS), ("ir", IR_SENSORS),
+                                ("encoders", ENCODERS)):
+                log(f"robots/{name}/sensors/{kind}",
+                    rr.SeriesLines(names=[f"{name} {s}" for s in names]), static=True)
 
     # --- per tick ----------------------------------------------------------------------
 
@@ -289,6 +307,8 @@ class Recorder:
         ir: np.ndarray,
         speed: np.ndarray,
         bearings: Sequence[Sequence[tuple[int, float]]],
+        encoders: np.ndarray,
+        battery: np.ndarray,
     ) -> None:
         """Buffer one control tick; sends a chunk every ``chunk_ticks`` ticks.
 
@@ -300,11 +320,14 @@ class Recorder:
             ir: (N, 3) IR distances (m), NaN = nothing, order of ``robot.IR_SENSORS``.
             speed: (N,) commanded linear speed (m/s).
             bearings: per robot, the (other robot, bearing in rad) pairs it sees.
+            encoders: (N, 2) wheel angles (rad), left and right.
+            battery: (N,) battery terminal voltage (V).
         """
         self._check_open()
         n = self.n_robots
         for name, value, shape in (("poses", poses, (n, 3)), ("line", line, (n, 3)),
-                                   ("ir", ir, (n, 3)), ("speed", speed, (n,))):
+                                   ("ir", ir, (n, 3)), ("speed", speed, (n,)),
+                                   ("encoders", encoders, (n, 2)), ("battery", battery, (n,))):
             if np.shape(value) != shape:
                 raise ValueError(f"log_tick: {name} has shape {np.shape(value)}, expected {shape}")
         if len(bearings) != n:
@@ -316,6 +339,8 @@ class Recorder:
         self._line[k] = line
         self._ir[k] = ir
         self._speed[k] = speed
+        self._encoders[k] = encoders
+        self._battery[k] = battery
         for i, seen in enumerate(bearings):
             for j, bearing in seen:
                 self._bearing_rows.append(k)
@@ -335,6 +360,7 @@ class Recorder:
         # gets copies, never views of the buffers that the next ticks overwrite.
         steps, times = self._steps[:k].copy(), self._times[:k].copy()
         speed, line, ir = self._speed[:k].copy(), self._line[:k].copy(), self._ir[:k].copy()
+        encoders, battery = self._encoders[:k].copy(), self._battery[:k].copy()
         index = [rr.TimeColumn("step", sequence=steps), rr.TimeColumn("sim_time", duration=times)]
         xy = self._poses[:k, :, :2].copy()
         translation = np.concatenate([xy, np.zeros((k, n, 1))], axis=2)
@@ -345,13 +371,16 @@ class Recorder:
         trail[:, :, 0, :2] = start
         trail[:, :, 1, :2] = xy
         for i in range(n):
-            robot = f"robots/r{i}"
+            robot = f"robots/{robot_name(i)}"
             send(f"{robot}/pose", index, rr.Transform3D.columns(
                 translation=translation[:, i], quaternion=quaternion[:, i]))
             send(f"{robot}/trail", index, rr.LineStrips3D.columns(strips=trail[:, i]))
             send(f"{robot}/speed", index, rr.Scalars.columns(scalars=speed[:, i]))
+            send(f"{robot}/battery", index, rr.Scalars.columns(scalars=battery[:, i]))
             send(f"{robot}/sensors/line", index, rr.Scalars.columns(scalars=line[:, i]))
             send(f"{robot}/sensors/ir", index, rr.Scalars.columns(scalars=ir[:, i]))
+            send(f"{robot}/sensors/encoders", index,
+                 rr.Scalars.columns(scalars=encoders[:, i]))
         self._send_bearings(steps, times)
         self._trail_from = self._latest_xy = xy[-1]
         self._rows = 0
@@ -369,11 +398,12 @@ class Recorder:
         for group in np.split(np.arange(len(pairs)), cuts):
             pair = int(pairs[group[0]])
             i, j = divmod(pair, n)
-            entity = f"robots/r{i}/bearings/r{j}"
+            entity = f"robots/{robot_name(i)}/bearings/{robot_name(j)}"
             if pair not in self._bearing_series:
                 self._bearing_series.add(pair)
                 self._stream.log(entity, rr.SeriesPoints(
-                    names=f"r{i} sees r{j}", colors=robot_color(j), marker_sizes=2.0),
+                    names=f"{robot_name(i)} sees {robot_name(j)}", colors=robot_color(j),
+                    marker_sizes=2.0),
                     static=True)
             r = rows[group]
             self._stream.send_columns(
@@ -394,12 +424,10 @@ class Recorder:
         self._stream.set_time("sim_time", duration=sim_time_s)
 
     def log_event(self, step: int, sim_time_s: float, text: str, robot: int | None = None) -> None:
-        """A line in the event log (``events``, or ``events/r<robot>`` for a robot's event)."""
+        """A line in the event log: ``events``, or ``events/R<k>`` for robot index ``robot``."""
         self._at(step, sim_time_s)
-        if robot is None:
-            self._stream.log("events", rr.TextLog(text, level="INFO"))
-        else:
-            self._stream.log(f"events/r{robot}", rr.TextLog(f"r{robot}: {text}", level="INFO"))
+        entity = "events" if robot is None else f"events/{robot_name(robot)}"
+        self._stream.log(entity, rr.TextLog(text, level="INFO"))
 
     def log_explored_graph(
         self,
@@ -420,7 +448,7 @@ class Recorder:
         self._at(step, sim_time_s)
         ids = list(nodes)
         self._stream.log(
-            f"map/r{robot}",
+            f"map/{robot_name(robot)}",
             rr.GraphNodes(ids, positions=[(x, -y) for x, y in nodes.values()], labels=ids,
                           colors=robot_color(robot)),
             rr.GraphEdges(list(edges), graph_type="undirected"),
@@ -452,8 +480,8 @@ class Recorder:
             if not (0 <= a < n and 0 <= b < n):
                 raise ValueError(f"log_radio: edge ({a}, {b}) names a robot outside 0..{n - 1}")
         beliefs = dict(beliefs or {})
-        ids = [f"r{i}" for i in range(n)]
-        labels = [f"r{i}: {beliefs[i]}" if i in beliefs else f"r{i}" for i in range(n)]
+        ids = [robot_name(i) for i in range(n)]
+        labels = [f"{ids[i]}: {beliefs[i]}" if i in beliefs else ids[i] for i in range(n)]
         truths = (None if truth is None else
                   dict(truth) if isinstance(truth, Mapping) else dict.fromkeys(range(n), truth))
         if truths is None:
@@ -475,11 +503,11 @@ class Recorder:
                 colors=(60, 140, 255, 200), radii=0.003))
         if truth is not None or beliefs:
             if isinstance(truth, Mapping):
-                lines = [f"r{i}: {beliefs.get(i, '-')} (truth: {truth.get(i, '-')})"
+                lines = [f"{ids[i]}: {beliefs.get(i, '-')} (truth: {truth.get(i, '-')})"
                          for i in range(n)]
             else:
                 lines = [] if truth is None else [f"truth: {truth}"]
-                lines += [f"r{i}: {beliefs[i]}" for i in sorted(beliefs)]
+                lines += [f"{ids[i]}: {beliefs[i]}" for i in sorted(beliefs)]
             self._stream.log("radio/truth", rr.TextDocument("\n".join(lines)))
 
     def _positions(self) -> np.ndarray | None:
@@ -510,10 +538,12 @@ class Recorder:
         self.close()
 
 
-def _blueprint(arena: ArenaSpec, n_robots: int, trail_window_s: float) -> rrb.Blueprint:
+def _blueprint(arena: ArenaSpec, n_robots: int, trail_window_s: float,
+               radio: bool) -> rrb.Blueprint:
     """The layout the file opens with: 3-D arena + event log on the left; explored
-    graphs, radio graph and beacons on the top right; time series on the bottom right."""
-    robots = range(n_robots)
+    graphs, beacons (and the radio graph) on the top right; time series on the bottom
+    right."""
+    robots = [robot_name(i) for i in range(n_robots)]
     xy = np.array(list(arena.vertices.values()))
     centre = (xy.min(axis=0) + xy.max(axis=0)) / 2.0
     extent = float(max(np.ptp(xy, axis=0).max(), 1.0))
@@ -525,8 +555,8 @@ def _blueprint(arena: ArenaSpec, n_robots: int, trail_window_s: float) -> rrb.Bl
     scene = rrb.Spatial3DView(
         name="arena",
         origin="/",
-        contents=["+ /arena/**", "+ /robots/**", "+ /radio/links"],
-        overrides={f"/robots/r{i}/trail": trail_range for i in robots},
+        contents=["+ /arena/**", "+ /robots/**"] + (["+ /radio/links"] if radio else []),
+        overrides={f"/robots/{r}/trail": trail_range for r in robots},
         eye_controls=rrb.EyeControls3D(
             position=(centre[0], centre[1] - 0.8 * extent, 1.1 * extent),
             look_target=(centre[0], centre[1], 0.0),
@@ -534,24 +564,25 @@ def _blueprint(arena: ArenaSpec, n_robots: int, trail_window_s: float) -> rrb.Bl
         ),
     )
     if n_robots <= MAP_TAB_LIMIT:
-        maps = [rrb.GraphView(name=f"map r{i}", origin=f"/map/r{i}") for i in robots]
+        maps = [rrb.GraphView(name=f"map {r}", origin=f"/map/{r}") for r in robots]
     else:
         maps = [rrb.GraphView(name="maps", origin="/map")]
-    graphs = rrb.Tabs(
-        *maps,
-        rrb.GraphView(name="radio", origin="/radio/graph"),
-        rrb.TextDocumentView(name="beacons", origin="/beacons"),
-        rrb.TextDocumentView(name="radio truth", origin="/radio/truth"),
-    )
+    radio_views = [rrb.GraphView(name="radio", origin="/radio/graph"),
+                   rrb.TextDocumentView(name="radio truth", origin="/radio/truth")]
+    graphs = rrb.Tabs(*maps, rrb.TextDocumentView(name="beacons", origin="/beacons"),
+                      *(radio_views if radio else []))
+
+    def plot(name: str, leaf: str) -> rrb.TimeSeriesView:
+        return rrb.TimeSeriesView(name=name, origin="/robots",
+                                  contents=[f"+ /robots/{r}/{leaf}" for r in robots])
+
     series = rrb.Tabs(
-        rrb.TimeSeriesView(name="speed (m/s)", origin="/robots",
-                           contents=[f"+ /robots/r{i}/speed" for i in robots]),
-        rrb.TimeSeriesView(name="line sensors (m)", origin="/robots",
-                           contents=[f"+ /robots/r{i}/sensors/line" for i in robots]),
-        rrb.TimeSeriesView(name="IR (m)", origin="/robots",
-                           contents=[f"+ /robots/r{i}/sensors/ir" for i in robots]),
-        rrb.TimeSeriesView(name="bearings (rad)", origin="/robots",
-                           contents=[f"+ /robots/r{i}/bearings/**" for i in robots]),
+        plot("speed (m/s)", "speed"),
+        plot("line sensors (m)", "sensors/line"),
+        plot("IR (m)", "sensors/ir"),
+        plot("bearings (rad)", "bearings/**"),
+        plot("encoders (rad)", "sensors/encoders"),
+        plot("battery (V)", "battery"),
     )
     return rrb.Blueprint(
         rrb.Horizontal(

@@ -25,6 +25,8 @@ from mjswarm.errors import MjswarmError
 WORLDS = ("graph", "embodied")
 BACKENDS = ("local", "ray")
 CELL_KEYS = ("world", "arena", "robots", "strategy", "seed")
+#: Largest team a sweep runs (the benchmark's largest; beyond it a run takes hours).
+MAX_ROBOTS = 1000
 
 
 @dataclass(frozen=True)
@@ -58,6 +60,9 @@ def grid(world: str, arenas: Iterable[str], robots: Iterable[int], strategies: I
             raise MjswarmError(f"unknown strategy '{s}' (choose from {', '.join(STRATEGIES)})")
     if not robots or min(robots) < 1:
         raise MjswarmError("robot counts must be >= 1")
+    if max(robots) > MAX_ROBOTS:
+        raise MjswarmError(f"robot counts must be <= {MAX_ROBOTS} (got {max(robots)}; "
+                           "mjswarm bench measures up to 1000 robots)")
     if not (arenas and strategies and seeds):
         raise MjswarmError("a sweep needs at least one arena, strategy and seed")
     return [Cell(world, a, k, s, seed)

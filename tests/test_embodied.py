@@ -76,6 +76,26 @@ def test_cli_embodied_json_and_recording(tmp_path, capsys):
     verify = subprocess.run([*rerun_command(), "rrd", "verify", str(rrd)],
                             capture_output=True, text=True, timeout=120, check=False)
     assert verify.returncode == 0, verify.stderr
+    events = _texts(rrd)
+    assert "run ended: completed" in events["/events"]
+    assert f"R{out['declared_by']} declared completion at {out['declared_at']}" in (
+        events["/events"])
+    assert any(" speed " in t and "m/s" in t for key in ("/events/R1", "/events/R2")
+               for t in events.get(key, []))
+    assert any(t.startswith("R1 at ") for t in events["/events/R1"])
+
+
+def _texts(rrd) -> dict[str, list[str]]:
+    """Entity -> the TextLog lines of a recording."""
+    import rerun as rr
+
+    texts: dict[str, list[str]] = {}
+    for chunk in rr.chunk.RrdReader(rrd).stream():
+        batch = chunk.to_record_batch()
+        if "TextLog:text" in batch.schema.names:
+            texts.setdefault(chunk.entity_path, []).extend(
+                row[0] for row in batch.column("TextLog:text").to_pylist() if row)
+    return texts
 
 
 @pytest.mark.parametrize(

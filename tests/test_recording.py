@@ -40,6 +40,8 @@ def _random_run(rng: np.random.Generator, n: int, ticks: int) -> dict:
         "ir": ir,
         "speed": rng.uniform(0.0, 0.2, (ticks, n)),
         "bearings": bearings,
+        "encoders": np.cumsum(rng.uniform(-0.2, 0.2, (ticks, n, 2)), axis=0),
+        "battery": rng.uniform(8.0, 10.0, (ticks, n)),
     }
 
 
@@ -48,7 +50,8 @@ def _record(path: Path, arena, run: dict, chunk_ticks: int) -> None:
     with Recorder(path, arena, n, chunk_ticks=chunk_ticks) as rec:
         for k, step in enumerate(run["steps"]):
             rec.log_tick(int(step), float(run["times"][k]), run["poses"][k], run["line"][k],
-                         run["ir"][k], run["speed"][k], run["bearings"][k])
+                         run["ir"][k], run["speed"][k], run["bearings"][k],
+                         run["encoders"][k], run["battery"][k])
 
 
 def _read(path: Path) -> dict[str, dict[str, list]]:
@@ -78,11 +81,12 @@ def fig9_recording(tmp_path_factory) -> tuple[Path, dict]:
     path = tmp_path_factory.mktemp("rec") / "fig9.rrd"
     arena = load_arena("fig9")
     run = _random_run(np.random.default_rng(9), 3, 300)
-    with Recorder(path, arena, 3, chunk_ticks=128) as rec:
+    with Recorder(path, arena, 3, chunk_ticks=128, radio=True) as rec:
         for k, step in enumerate(run["steps"]):
             t = float(run["times"][k])
             rec.log_tick(int(step), t, run["poses"][k], run["line"][k], run["ir"][k],
-                         run["speed"][k], run["bearings"][k])
+                         run["speed"][k], run["bearings"][k], run["encoders"][k],
+                         run["battery"][k])
             if k == 10:
                 rec.log_event(int(step), t, "run started")
                 rec.log_event(int(step), t, "arrived at vertex b1", robot=2)
@@ -107,21 +111,23 @@ def test_entity_tree_and_timelines(fig9_recording):
     path, _ = fig9_recording
     data = _read(path)
     expected = {"static:/arena/strips", "static:/arena/walls", "static:/arena/vertices",
-                "/map/r1", "/beacons/b1", "/radio/graph", "/radio/links", "/radio/truth",
-                "/events", "/events/r2"}
-    for i in range(3):
-        expected |= {f"/robots/r{i}/pose", f"static:/robots/r{i}/pose",
-                     f"static:/robots/r{i}/pose/heading", f"/robots/r{i}/trail",
-                     f"/robots/r{i}/speed", f"/robots/r{i}/sensors/line",
-                     f"/robots/r{i}/sensors/ir"}
+                "/map/R2", "/beacons/b1", "/radio/graph", "/radio/links", "/radio/truth",
+                "/events", "/events/R3"}
+    for r in ("R1", "R2", "R3"):
+        expected |= {f"/robots/{r}/pose", f"static:/robots/{r}/pose",
+                     f"static:/robots/{r}/pose/heading", f"/robots/{r}/trail",
+                     f"/robots/{r}/speed", f"/robots/{r}/sensors/line",
+                     f"/robots/{r}/sensors/ir", f"/robots/{r}/sensors/encoders",
+                     f"/robots/{r}/battery"}
     assert expected <= set(data)
-    assert any(key.startswith("/robots/r0/bearings/r") for key in data)
+    assert not any("/r0" in key or "/r1" in key for key in data)  # one numbering: R1..RK
+    assert any(key.startswith("/robots/R1/bearings/R") for key in data)
     for key, columns in data.items():
         if not key.startswith("static:") and key != "/__properties":
             assert {"step", "sim_time"} <= set(columns), key
-    assert len(data["/map/r1"]["step"]) == 1  # the repeated identical graph was skipped
-    assert data["/radio/graph"]["GraphNodes:labels"] == [["r0: yes", "r1: no", "r2"]]
-    assert data["/events/r2"]["TextLog:text"] == [["r2: arrived at vertex b1"]]
+    assert len(data["/map/R2"]["step"]) == 1  # the repeated identical graph was skipped
+    assert data["/radio/graph"]["GraphNodes:labels"] == [["R1: yes", "R2: no", "R3"]]
+    assert data["/events/R3"]["TextLog:text"] == [["arrived at vertex b1"]]
 
 
 def test_static_arena_matches_the_spec(fig9_recording):
@@ -136,6 +142,17 @@ def test_static_arena_matches_the_spec(fig9_recording):
     assert data["static:/arena/vertices"]["Points3D:labels"][0] == list(arena.vertices)
 
 
+def _view_names(path: Path) -> list[str]:
+    reader = rr.chunk.RrdReader(path)
+    names = []
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        batch = chunk.to_record_batch()
+        if "ViewBlueprint:display_name" in batch.schema.names:
+            names += [row[0] for row in batch.column("ViewBlueprint:display_name").to_pylist()
+                      if row]
+    return names
+
+
 def test_blueprint_has_the_review_views(fig9_recording):
     path, _ = fig9_recording
     reader = rr.chunk.RrdReader(path)
@@ -145,6 +162,16 @@ def test_blueprint_has_the_review_views(fig9_recording):
         if "ViewBlueprint:class_identifier" in batch.schema.names:
             kinds += [row[0] for row in batch.column("ViewBlueprint:class_identifier").to_pylist()]
     assert {"3D", "Graph", "TimeSeries", "TextLog", "TextDocument"} <= set(kinds)
+    names = _view_names(path)
+    assert {"radio", "radio truth", "battery (V)", "encoders (rad)", "map R1"} <= set(names)
+
+
+def test_blueprint_without_radio_has_no_radio_views(tmp_path):
+    """Issue 18: a run without radios does not open on empty radio views."""
+    path = tmp_path / "quiet.rrd"
+    Recorder(path, load_arena("fig9"), 2).close()
+    names = _view_names(path)
+    assert "map R2" in names and "radio" not in names and "radio truth" not in names
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -158,7 +185,7 @@ def test_ticks_read_back_equal_to_what_was_logged(tmp_path, seed):
     _record(path, arena, run, chunk_ticks)
     data = _read(path)
     for i in range(n):
-        robot = f"/robots/r{i}"
+        robot = f"/robots/R{i + 1}"
         steps, translation = _by_step(data[f"{robot}/pose"], "Transform3D:translation")
         np.testing.assert_array_equal(steps, run["steps"])
         xy = run["poses"][:, i, :2]
@@ -174,7 +201,8 @@ def test_ticks_read_back_equal_to_what_was_logged(tmp_path, seed):
         segments = np.array(trail)[:, 0, :, :2]  # (ticks, 2 points, xy)
         np.testing.assert_allclose(segments[:, 1], xy, atol=1e-5)
         np.testing.assert_allclose(segments[1:, 0], xy[:-1], atol=1e-5)
-        for entity, key in (("speed", "speed"), ("sensors/line", "line"), ("sensors/ir", "ir")):
+        for entity, key in (("speed", "speed"), ("sensors/line", "line"), ("sensors/ir", "ir"),
+                            ("sensors/encoders", "encoders"), ("battery", "battery")):
             _, values = _by_step(data[f"{robot}/{entity}"], "Scalars:scalars")
             np.testing.assert_array_equal(np.array(values, dtype=float).reshape(ticks, -1),
                                           run[key][:, i].reshape(ticks, -1))
@@ -182,7 +210,7 @@ def test_ticks_read_back_equal_to_what_was_logged(tmp_path, seed):
     for k, per_robot in enumerate(run["bearings"]):
         for i, seen in enumerate(per_robot):
             for j, bearing in seen:
-                logged[f"/robots/r{i}/bearings/r{j}"].append((run["steps"][k], bearing))
+                logged[f"/robots/R{i + 1}/bearings/R{j + 1}"].append((run["steps"][k], bearing))
     read = {key: list(zip(*_by_step(columns, "Scalars:scalars")))
             for key, columns in data.items() if key.startswith("/robots/") and "/bearings/" in key}
     assert set(read) == set(logged)
@@ -205,7 +233,7 @@ def test_misuse_is_caught(tmp_path):
     rec = Recorder(tmp_path / "run.rrd", load_arena("fig9"), 2)
     with pytest.raises(ValueError, match="poses"):
         rec.log_tick(0, 0.0, np.zeros(3), np.zeros((2, 3)), np.zeros((2, 3)), np.zeros(2),
-                     [[], []])
+                     [[], []], np.zeros((2, 2)), np.zeros(2))
     with pytest.raises(ValueError, match="outside"):
         rec.log_radio(0, 0.0, [(0, 2)])
     rec.close()

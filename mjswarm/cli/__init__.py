@@ -13,6 +13,7 @@ import importlib
 import sys
 
 from mjswarm import __version__
+from mjswarm.cli.output import interrupted_outputs
 from mjswarm.errors import MjswarmError
 
 #: Subcommand modules, in the order ``--help`` lists them.
@@ -45,7 +46,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"mjswarm: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("mjswarm: interrupted", file=sys.stderr)
+        kept = ", ".join(interrupted_outputs)
+        print("mjswarm: interrupted" + (f"; partial output kept: {kept}" if kept else ""),
+              file=sys.stderr)
         return 130
     except BrokenPipeError:  # e.g. `mjswarm ... | head`: the reader left, nothing to say
         sys.stderr.close()

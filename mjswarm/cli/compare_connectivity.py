@@ -8,7 +8,7 @@ from dataclasses import asdict
 
 from tqdm import tqdm
 
-from mjswarm.cli.output import write_json
+from mjswarm.cli.output import check_writable, write_json
 from mjswarm.connectivity.comparison import (
     FAMILIES,
     compare_messages,
@@ -48,6 +48,7 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_writable(args.json, "JSON")  # before any work, not after it
     if args.n_step < 1 or args.n_min > args.n_max:
         raise MjswarmError("need --n-step >= 1 and --n-min <= --n-max")
     if args.message_cap < 1:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from mjswarm.cli.output import write_json
+from mjswarm.cli.output import check_writable, write_json
 from mjswarm.connectivity import DEFAULT_MESSAGE_CAP, METHODS, load_team, run_check
 
 
@@ -62,6 +62,7 @@ def _yes_no(value: bool | None) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_writable(args.json, "JSON")  # before any work, not after it
     team = load_team(args.positions)
     result = run_check(
         team,

@@ -9,7 +9,7 @@ import time
 from tqdm import tqdm
 
 from algorithms.maintenance.biconnected import PLACEMENTS
-from mjswarm.cli.output import write_json
+from mjswarm.cli.output import check_writable, write_json
 from mjswarm.coverage_experiment import WORLDS, run_coverage
 
 
@@ -45,6 +45,7 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_writable(args.json, "JSON")  # before any work, not after it
     start = time.perf_counter()
     with tqdm(total=args.episodes, desc="episodes", unit="ep", file=sys.stderr,
               disable=not sys.stderr.isatty()) as bar:

@@ -7,7 +7,7 @@ import sys
 
 from tqdm import tqdm
 
-from mjswarm.cli.output import write_json
+from mjswarm.cli.output import check_writable, write_json
 from mjswarm.errors import MjswarmError
 from mjswarm.patrol_experiment import STEP_S, WORLDS, run_patrol
 
@@ -47,6 +47,7 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_writable(args.json, "JSON")  # before any work, not after it
     if args.steps < 1:
         raise MjswarmError(f"need at least one step, got {args.steps}")
     with tqdm(total=args.trials * args.steps, desc="steps", unit="step", file=sys.stderr,

@@ -8,7 +8,7 @@ world is a function ``run_<world>(args) -> dict`` registered in :data:`WORLDS`.
 from __future__ import annotations
 
 from algorithms.exploration import STRATEGIES
-from mjswarm.cli.output import write_json
+from mjswarm.cli.output import atomic_output, check_writable, write_json
 from mjswarm.errors import MjswarmError
 from mjswarm.graphworld import EDGE_TIMES, GraphWorld
 
@@ -18,7 +18,7 @@ def run_graph(args) -> dict:
     from mjswarm.arena import load_arena
 
     spec = load_arena(args.arena)
-    world = GraphWorld(spec.graph(), args.root or spec.root, edge_time=args.edge_time)
+    world = GraphWorld(spec.graph(), args.root or spec.root, edge_time=args.edge_time or "unit")
     result = world.explore(
         args.robots, args.strategy, seed=args.seed, max_time=args.max_time, arena=spec.name
     )
@@ -26,12 +26,15 @@ def run_graph(args) -> dict:
 
 
 def run_embodied(args) -> dict:
-    """One run with MuJoCo robots; the JSON-ready result (see ``EmbodiedResult``)."""
-    import sys
+    """One run with MuJoCo robots; the JSON-ready result (see ``EmbodiedResult``).
 
+    Every option is checked, and the world built, before any output file is opened; the
+    recording goes to a temporary file that replaces ``--record`` when the run ends
+    (:func:`mjswarm.cli.output.atomic_output`)."""
     from mjswarm.arena import ArenaSpec, load_arena
-    from mjswarm.embodied import EmbodiedConfig, explore_embodied
+    from mjswarm.embodied import EmbodiedConfig, EmbodiedExploration
     from mjswarm.faults import parse_fault
+    from mjswarm.graphworld import make_minds
     from mjswarm.recording import Recorder
 
     spec = load_arena(args.arena)
@@ -45,23 +48,33 @@ def run_embodied(args) -> dict:
         except ValueError:
             raise MjswarmError(f"--launch-order takes robot numbers like 2,1,3, "
                                f"got '{args.launch_order}'") from None
+    defaults = EmbodiedConfig()
     config = EmbodiedConfig(
-        speed_m_s=args.speed, collision_avoidance=not args.no_collision_avoidance,
-        launch_interval_s=args.launch_interval, launch_order=order,
-        radio_range_m=args.radio_range,
-        max_sim_time_s=args.max_time or EmbodiedConfig.max_sim_time_s,
+        speed_m_s=_or(args.speed, defaults.speed_m_s),
+        collision_avoidance=not args.no_collision_avoidance,
+        launch_interval_s=_or(args.launch_interval, defaults.launch_interval_s),
+        launch_order=order, radio_range_m=args.radio_range,
+        max_sim_time_s=_or(args.max_time, defaults.max_sim_time_s),
         stall_timeout_s=args.stall_timeout,
-        faults=[parse_fault(f) for f in args.fault],
-        line_noise_m=args.line_noise, ir_noise_m=args.ir_noise, wheel_slip=args.wheel_slip)
-    progress = sys.stderr.isatty()
+        faults=[parse_fault(f) for f in args.fault or ()],
+        line_noise_m=_or(args.line_noise, 0.0), ir_noise_m=_or(args.ir_noise, 0.0),
+        wheel_slip=_or(args.wheel_slip, 0.0))
+    run = EmbodiedExploration(spec, make_minds(args.strategy, args.robots, args.seed), config,
+                              args.seed)
+    check_writable(args.json, "JSON")
     if args.record:
-        with Recorder(args.record, spec, args.robots) as recorder:
-            result = explore_embodied(spec, args.robots, args.strategy, config, args.seed,
-                                      recorder, progress)
+        with atomic_output(args.record, "recording") as temp, \
+                Recorder(temp, spec, args.robots, radio=args.radio_range is not None) \
+                as run.recorder:
+            result = run.run(progress=True)
     else:
-        result = explore_embodied(spec, args.robots, args.strategy, config, args.seed,
-                                  progress=progress)
+        result = run.run(progress=True)
     return {"world": "embodied", **result.to_dict(), "recording": args.record}
+
+
+def _or(value, default):
+    """``value`` unless the option was not given (None)."""
+    return default if value is None else value
 
 
 #: World name -> runner.
@@ -104,17 +117,17 @@ def register(subparsers) -> None:
                         help="give up after T: graph world time units (default: "
                              "50 (E + 1) + 100); embodied simulated seconds (default: 3600)")
     graph = parser.add_argument_group("graph world")
-    graph.add_argument("--edge-time", default="unit", choices=EDGE_TIMES,
+    graph.add_argument("--edge-time", default=None, choices=EDGE_TIMES,
                        help="time to traverse an edge: 'unit' (1 step each, as in the "
                             "paper) or 'length' (length / mean edge length) (default: unit)")
     embodied = parser.add_argument_group("embodied world")
-    embodied.add_argument("--speed", type=float, default=0.05, metavar="M_S",
+    embodied.add_argument("--speed", type=float, default=None, metavar="M_S",
                           help="initial speed S of every robot, m/s (default: 0.05, the "
                                "paper's experiments; top speed 0.20)")
     embodied.add_argument("--no-collision-avoidance", action="store_true",
                           help="turn off the bearing-rate speed rule and the vertex-entry "
                                "check, for comparison")
-    embodied.add_argument("--launch-interval", type=float, default=2.0, metavar="S",
+    embodied.add_argument("--launch-interval", type=float, default=None, metavar="S",
                           help="least time between two robots leaving the root, seconds "
                                "(default: 2)")
     embodied.add_argument("--launch-order", default=None, metavar="I,J,...",
@@ -128,16 +141,16 @@ def register(subparsers) -> None:
                           help="end the run, not completed, when no robot has reached a vertex "
                                "for S simulated seconds (default: 300 s, or 10x the time to "
                                "drive the longest edge if that is longer)")
-    embodied.add_argument("--fault", action="append", default=[], metavar="FAULT",
+    embodied.add_argument("--fault", action="append", default=None, metavar="FAULT",
                           help="inject a fault (repeatable): robot:I@T (robot I fails at T s "
                                "and stays as an obstacle), beacon:V@T (the beacon at vertex V "
                                "is wiped), radio-blackout@T1-T2 (no radio message gets "
                                "through; needs --radio-range)")
-    embodied.add_argument("--line-noise", type=float, default=0.0, metavar="M",
+    embodied.add_argument("--line-noise", type=float, default=None, metavar="M",
                           help="standard deviation of the line sensors' noise, m (default: 0)")
-    embodied.add_argument("--ir-noise", type=float, default=0.0, metavar="M",
+    embodied.add_argument("--ir-noise", type=float, default=None, metavar="M",
                           help="standard deviation of the IR sensors' noise, m (default: 0)")
-    embodied.add_argument("--wheel-slip", type=float, default=0.0, metavar="S",
+    embodied.add_argument("--wheel-slip", type=float, default=None, metavar="S",
                           help="wheel slip: each tick each encoder over-reads its wheel's "
                                "turn by |N(0, S)| of it (default: 0)")
     embodied.add_argument("--record", default=None, metavar="FILE.rrd",
@@ -148,9 +161,36 @@ def register(subparsers) -> None:
     parser.set_defaults(func=run)
 
 
-def run(args) -> int:
+#: Options of the embodied world only (argparse dest -> flag), refused with --world graph.
+EMBODIED_ONLY = {
+    "speed": "--speed", "no_collision_avoidance": "--no-collision-avoidance",
+    "launch_interval": "--launch-interval", "launch_order": "--launch-order",
+    "radio_range": "--radio-range", "stall_timeout": "--stall-timeout", "fault": "--fault",
+    "line_noise": "--line-noise", "ir_noise": "--ir-noise", "wheel_slip": "--wheel-slip",
+    "record": "--record",
+}
+
+
+def check_options(args) -> None:
+    """Refuse what would be silently ignored or is impossible, in one line."""
     if args.world not in WORLDS:
         raise MjswarmError(f"unknown world '{args.world}' (choose from {', '.join(WORLDS)})")
+    if args.world == "graph":
+        given = [flag for dest, flag in EMBODIED_ONLY.items() if getattr(args, dest)]
+        if given:
+            raise MjswarmError(f"{', '.join(given)} only apply to the embodied world "
+                               "(--world embodied)")
+    elif args.edge_time is not None:
+        raise MjswarmError("--edge-time only applies to the graph world (--world graph)")
+    if args.max_time is not None and not args.max_time > 0:
+        raise MjswarmError(f"--max-time must be positive, got {args.max_time:g}")
+    if args.launch_interval is not None and not args.launch_interval >= 0:
+        raise MjswarmError(f"--launch-interval must be >= 0 s, got {args.launch_interval:g}")
+    check_writable(args.json, "JSON")
+
+
+def run(args) -> int:
+    check_options(args)
     result = WORLDS[args.world](args)
     if write_json(result, args.json):
         return 0 if result["completed"] else 1
@@ -170,11 +210,11 @@ def summary(result: dict) -> str:
         return "\n".join(lines)
     per_robot = " ".join(f"R{i + 1}={n}" for i, n in enumerate(result["traversals_per_robot"]))
     verdict = "equal to" if result["map_correct"] else "DIFFERENT from"
-    unit = "edges by one robot" if result["world"] == "embodied" else "steps"
+    unit = "edges (most by any robot)" if result["world"] == "embodied" else "steps"
     lines = [
         head,
-        f"completed: R{result['declared_by']} declared at {result['declared_at']} after "
-        + f"{result['makespan']} {unit}",
+        f"completed: R{result['declared_by']} declared completion at {result['declared_at']}; "
+        f"makespan {result['makespan']:g} {unit}",
         f"traversals: {result['total_traversals']} in total ({per_robot})",
         f"map: {len(result['map_edges'])} edges, {verdict} the arena's",
     ]

@@ -9,14 +9,24 @@ from tqdm import tqdm
 from mjswarm.errors import MjswarmError
 
 
+#: Most values one list option may expand to.
+MAX_LIST = 10_000
+
+
 def _ints(text: str, what: str) -> list[int]:
-    """``1,2,5`` or ``0-9`` or a mix: ``0-3,7``."""
+    """``1,2,5`` or ``0-9`` or a mix: ``0-3,7``; at most MAX_LIST values."""
     values: list[int] = []
     try:
         for part in text.split(","):
             if "-" in part.strip()[1:]:
-                lo, hi = part.split("-", 1)
-                values.extend(range(int(lo), int(hi) + 1))
+                lo, hi = (int(x) for x in part.split("-", 1))
+                if hi < lo:
+                    raise MjswarmError(f"{what}: the range {lo}-{hi} is reversed "
+                                       f"(write {hi}-{lo})")
+                if hi - lo + 1 > MAX_LIST:
+                    raise MjswarmError(f"{what}: the range {lo}-{hi} has more than "
+                                       f"{MAX_LIST} values")
+                values.extend(range(lo, hi + 1))
             elif part.strip():
                 values.append(int(part))
     except ValueError:
