@@ -40,6 +40,11 @@ from collections import deque
 from dataclasses import dataclass, field
 
 
+#: ``S``, the initial speed of seed 003's experiments (Sec. 5: 5 cm/s), m/s: the default
+#: speed of embodied runs.
+PAPER_SPEED_M_S = 0.05
+
+
 def epsilons(k: int, largest: float = 0.5, spread: float = 1.5) -> list[float]:
     """Speed-change terms ``eps_1 .. eps_K`` satisfying eq. (28).
 

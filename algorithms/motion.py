@@ -1,6 +1,6 @@
-"""Velocity tracking and go-to-point for a differential-drive (unicycle) robot.
+"""Velocity tracking for a differential-drive (unicycle) robot.
 
-Pure functions: pose in, ``(v, omega)`` out. They turn the planar velocity commands of the
+A pure function: pose in, ``(v, omega)`` out. It turns the planar velocity commands of the
 connectivity papers (seed 001's ``u_i``, seed 002's "drive towards") into what a
 differential-drive robot can do: turn towards the commanded direction and drive forward
 at the commanded speed scaled by ``cos`` of the heading error (never backwards), within
@@ -26,16 +26,3 @@ def track_velocity(yaw: float, velocity: tuple[float, float], v_max: float,
     omega = max(-omega_max, min(omega_max, heading_gain * error))
     v = max(0.0, min(v_max, speed * math.cos(error)))
     return v, omega
-
-
-def go_to(position: tuple[float, float], yaw: float, target: tuple[float, float],
-          v_max: float, omega_max: float, gain: float = 1.0,
-          tolerance_m: float = 0.02) -> tuple[float, float]:
-    """``(v, omega)`` driving to ``target`` (m): a proportional velocity ``gain (target -
-    position)`` capped at ``v_max``; zero within ``tolerance_m``."""
-    dx, dy = target[0] - position[0], target[1] - position[1]
-    distance = math.hypot(dx, dy)
-    if distance < tolerance_m:
-        return 0.0, 0.0
-    speed = min(v_max, gain * distance)
-    return track_velocity(yaw, (dx / distance * speed, dy / distance * speed), v_max, omega_max)

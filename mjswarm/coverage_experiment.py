@@ -50,7 +50,8 @@ import numpy as np
 from algorithms.maintenance.biconnected import PLACEMENTS, BiconnectedRobot, Params
 from algorithms.maintenance.regions import union_area
 from mjswarm.errors import MjswarmError
-from mjswarm.openfloor import V_MAX_M_S, EmbodiedFloor, MotionWorld, PointWorld
+from mjswarm.openfloor import EmbodiedFloor, MotionWorld, PointWorld
+from mjswarm.robot import spark_v_geometry
 from mjswarm.radio import Radio
 
 MAX_ROBOTS = 10
@@ -139,7 +140,7 @@ class CoverageRun:
         self.params = Params(link_m=(cr - 1.0) * region_diameter_m,
                              region_radius_m=region_diameter_m / 2.0,
                              max_robots=MAX_ROBOTS, placement=placement,
-                             v_max=V_MAX_M_S, clearance_m=clearance_m)
+                             v_max=spark_v_geometry().max_speed_m_s, clearance_m=clearance_m)
         self.rng = np.random.default_rng(seed)
         self.max_ticks = max_ticks
         self.result = CoverageResult(self.cr, placement, world, seed, region_diameter_m,

@@ -65,7 +65,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from tqdm import tqdm
 
-from algorithms.collision import CollisionRule, epsilons
+from algorithms.collision import PAPER_SPEED_M_S, CollisionRule, epsilons
 from algorithms.exploration import Beacon, Strategy
 from algorithms.exploration.base import AngleMismatch
 from algorithms.navigation import NavigatorState
@@ -123,7 +123,7 @@ class EmbodiedConfig:
         wheel_slip: scale of the wheel-slip model (:class:`mjswarm.simulation.Simulation`).
     """
 
-    speed_m_s: float = 0.05
+    speed_m_s: float = PAPER_SPEED_M_S
     collision_avoidance: bool = True
     epsilons: list[float] | None = None
     launch_interval_s: float = 2.0

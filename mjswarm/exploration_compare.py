@@ -35,10 +35,6 @@ LABELS = {
     "flooding": "flooding",
 }
 
-#: The paper's 4 x 4 lattice numbers (section 6, 5 robots).
-PAPER_LATTICE_4X4 = {"incidence-dfs": 11, "mr-dfs": 16}
-
-
 @dataclass(frozen=True)
 class Setting:
     """One panel of a comparison: an arena and start vertex, strategies, robot counts."""

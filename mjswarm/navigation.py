@@ -69,7 +69,7 @@ class NavigationDriver:
         speed_m_s: cruising speed of every navigator.
     """
 
-    def __init__(self, sim: Simulation, headings: Sequence[float], speed_m_s: float = 0.05,
+    def __init__(self, sim: Simulation, headings: Sequence[float], speed_m_s: float,
                  turn_rate_rad_s: float = 1.0) -> None:
         self.sim = sim
         cal, conv = calibration(sim.geometry), conventions(sim.geometry)

@@ -5,7 +5,7 @@ MuJoCo robots (:class:`EmbodiedFloor`) and on kinematic points (:class:`PointWor
 
 * robots take **planar velocity commands** (m/s, world frame) and follow them with the
   unicycle tracker of :mod:`algorithms.motion` within the Spark V's limits
-  (0.2 m/s, ``omega_max``);
+  (the robot model's top speed, ``omega_max``);
 * robots **sense their own position and heading** through a positioning sensor (the
   papers assume robots know their positions; think UWB or motion capture) with optional
   Gaussian noise; controllers use :meth:`MotionWorld.sense` only;
@@ -25,9 +25,9 @@ import numpy as np
 
 from algorithms.motion import track_velocity
 from mjswarm.errors import MjswarmError
+from mjswarm.robot import spark_v_geometry
 
-#: Spark V top speed (m/s) and the turn rate we allow the tracker (rad/s).
-V_MAX_M_S = 0.2
+#: The turn rate we allow the tracker (rad/s); the top speed is the robot model's.
 OMEGA_MAX_RAD_S = 2.0
 
 
@@ -86,7 +86,8 @@ class MotionWorld(ABC):
         """Follow planar velocities (m/s, shape (N, 2)) for ``duration_s`` seconds."""
         velocities = np.asarray(velocities, float).reshape(self.n, 2)
         sensed = self.sense()
-        commands = [track_velocity(sensed[i, 2], velocities[i], V_MAX_M_S, self.omega_max_rad_s)
+        v_max = spark_v_geometry().max_speed_m_s
+        commands = [track_velocity(sensed[i, 2], velocities[i], v_max, self.omega_max_rad_s)
                     if self.present[i] else (0.0, 0.0) for i in range(self.n)]
         v, omega = (np.array(c) for c in zip(*commands))
         self._advance(v, omega, duration_s)

@@ -9,6 +9,7 @@ named parts mjswarm drives) become one-line :class:`~mjswarm.errors.MjswarmError
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 
 import mujoco
@@ -103,3 +104,11 @@ def measure_geometry(model: mujoco.MjModel, prefix: str = "") -> RobotGeometry:
         ir_range_m=float(model.sensor(prefix + IR_SENSORS[0]).cutoff[0]),
         ir_side_offset_m=float(model.site(prefix + IR_SENSORS[0]).pos[1]),
     )
+
+
+@cache
+def spark_v_geometry() -> RobotGeometry:
+    """The shipped robot's dimensions (``models/spark_v.xml``), for worlds without a
+    MuJoCo model of their own (the kinematic point world) and for defaults: the one home
+    of the top speed and every other body constant."""
+    return measure_geometry(load_robot_spec().compile())

@@ -82,7 +82,7 @@ def test_theorem1_check_agrees_with_networkx():
 @pytest.mark.parametrize("seed", range(10))
 def test_heuristic_choice_is_a_feasible_grid_optimum(seed):
     rng = np.random.default_rng(seed)
-    params = Params(link_m=1.0, region_radius_m=0.5)
+    params = Params(link_m=1.0, region_radius_m=0.5, v_max=0.2)
     # a random connected team: each new centre within the plan range of an earlier one
     pts = [np.zeros(2)]
     while len(pts) < int(rng.integers(3, 8)):
@@ -109,7 +109,7 @@ def test_heuristic_choice_is_a_feasible_grid_optimum(seed):
 @pytest.mark.parametrize("seed", range(15))
 def test_least_d_is_the_first_step_that_makes_the_ex_neighbours_biconnected(seed):
     rng = np.random.default_rng(seed)
-    params = Params(link_m=1.0, region_radius_m=0.5)
+    params = Params(link_m=1.0, region_radius_m=0.5, v_max=0.2)
     pos = (0.0, 0.0)
     ex = {}
     for i in range(int(rng.integers(2, 6))):

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from algorithms.motion import go_to, track_velocity
+from algorithms.motion import track_velocity
 from mjswarm.errors import MjswarmError
 from mjswarm.openfloor import EmbodiedFloor, PointWorld, spread
 
@@ -19,7 +19,6 @@ def test_track_velocity_turns_first_and_never_reverses():
     assert v == 0.0 and abs(w) == 2.0
     v, w = track_velocity(0.0, (0.0, 0.5), 0.2, 2.0)
     assert v == pytest.approx(0.0, abs=1e-12) and w == 2.0
-    assert go_to((0, 0), 0.0, (0.01, 0.0), 0.2, 2.0) == (0.0, 0.0)
 
 
 @pytest.mark.parametrize("world", [PointWorld, EmbodiedFloor])

@@ -145,6 +145,21 @@ def test_wheel_slip_makes_encoders_over_read_and_is_seeded():
         Simulation(world_spec([Pose2D(0.0, 0.0, 0.0)]), wheel_slip=-0.1)
 
 
+def test_scene_xml_loads_with_the_worlds_physics_settings():
+    """models/scene.xml (for the viewer) uses the timestep and integrator every world
+    uses (mjswarm.world), and holds one robot."""
+    import mujoco
+
+    from mjswarm.robot import MODELS_DIR, spark_v_geometry
+    from mjswarm.world import PHYSICS_TIMESTEP_S
+
+    model = mujoco.MjModel.from_xml_path(str(MODELS_DIR / "scene.xml"))
+    assert model.opt.timestep == PHYSICS_TIMESTEP_S
+    assert model.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    assert world_spec([Pose2D(0, 0, 0)]).option.integrator == model.opt.integrator
+    assert spark_v_geometry().max_speed_m_s == pytest.approx(0.2)
+
+
 def test_ten_minutes_of_random_commands_stay_stable():
     """Like menagerie's model tests: no NaN, no warning, upright, on the floor."""
     walls = [WallSegment(a, b) for a, b in [((-1, -1), (1, -1)), ((1, -1), (1, 1)),

@@ -131,13 +131,13 @@ class Params:
 
     link_m: float                 #: centres at most this far apart are neighbours
     region_radius_m: float        #: radius of every region (min-intersection placement)
+    v_max: float                  #: top speed (the robot's, from its model)
     max_robots: int = 10          #: N of Assumption 1 (the check waits 3N ticks)
     placement: str = "heuristic"  #: one of PLACEMENTS
     margin_m: float = 0.03        #: planned links are at most link_m - margin_m long
     d_step_m: float = 0.05        #: the leader's step when raising d
     d_extra_m: float = 0.1        #: the constant d' after a failed check
     tick_s: float = 0.1           #: one control tick (the papers' c)
-    v_max: float = 0.2            #: top speed
     gain: float = 2.0             #: proportional gain towards a target (1/s)
     tolerance_m: float = 0.01     #: arrived when this close to the target
     settle_s: float = 4.0         #: extra wait after a Move before checking

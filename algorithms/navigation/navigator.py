@@ -103,7 +103,7 @@ class Navigator:
     """
 
     def __init__(self, calibration: RobotCalibration, conventions: ArenaConventions,
-                 heading: float = 0.0, speed_m_s: float = 0.05,
+                 heading: float, speed_m_s: float,
                  turn_rate_rad_s: float = 1.0) -> None:
         self.cal, self.conv = calibration, conventions
         self.odometry = Odometry(calibration, theta=heading)

@@ -7,10 +7,12 @@ world is a function ``run_<world>(args) -> dict`` registered in :data:`WORLDS`.
 
 from __future__ import annotations
 
+from algorithms.collision import PAPER_SPEED_M_S
 from algorithms.exploration import STRATEGIES
 from mjswarm.cli.output import atomic_output, check_writable, write_json
 from mjswarm.errors import MjswarmError
 from mjswarm.graphworld import EDGE_TIMES, GraphWorld
+from mjswarm.robot import spark_v_geometry
 
 
 def run_graph(args) -> dict:
@@ -122,8 +124,10 @@ def register(subparsers) -> None:
                             "paper) or 'length' (length / mean edge length) (default: unit)")
     embodied = parser.add_argument_group("embodied world")
     embodied.add_argument("--speed", type=float, default=None, metavar="M_S",
-                          help="initial speed S of every robot, m/s (default: 0.05, the "
-                               "paper's experiments; top speed 0.20)")
+                          help=f"initial speed S of every robot, m/s (default: "
+                               f"{PAPER_SPEED_M_S:g}, the paper's experiments; top "
+                               f"speed {spark_v_geometry().max_speed_m_s:.2f}, the robot "
+                               "model's)")
     embodied.add_argument("--no-collision-avoidance", action="store_true",
                           help="turn off the bearing-rate speed rule and the vertex-entry "
                                "check, for comparison")
