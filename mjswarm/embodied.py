@@ -68,7 +68,7 @@ from tqdm import tqdm
 from algorithms.collision import PAPER_SPEED_M_S, CollisionRule, epsilons
 from algorithms.exploration import Beacon, Strategy
 from algorithms.exploration.base import AngleMismatch
-from algorithms.navigation import NavigatorState
+from algorithms.navigation import NavEvent, NavigatorState
 from mjswarm.arena import ArenaSpec
 from mjswarm.arena.geometry import LANE_OFFSET_M, VERTEX_CLEAR_RADIUS_M
 from mjswarm.arena.builder import arena_world_spec
@@ -402,12 +402,12 @@ class EmbodiedExploration:
         new = nav.events[self.handled_events[i]:]
         self.handled_events[i] = len(nav.events)
         for event in new:
-            if event == "arrived":
+            if event.kind is NavEvent.ARRIVED:
                 self.rules[i].crossed_vertex()  # eq. (34)
                 # the scan right after a launch is no arrival: the robot came by no edge
                 self._at_vertex(i, arrived=nav.arrived_angle is not None)
-            elif event.startswith("lost"):
-                self._stop(i, event)
+            elif event.kind is NavEvent.LOST:
+                self._stop(i, str(event))
         waiting = self.waiting_since[i]
         if waiting is not None and self.sim.time_s - waiting >= self.config.idle_wait_s:
             self.waiting_since[i] = None

@@ -5,13 +5,21 @@ readings (line sensors, IR, wheel encoders) in, and applies the ``(v, omega)`` t
 out. Nothing here knows the arena graph or any ground truth.
 """
 
-from algorithms.navigation.navigator import ArenaConventions, Navigator, NavigatorState
+from algorithms.navigation.navigator import (
+    ArenaConventions,
+    NavEvent,
+    Navigator,
+    NavigatorEvent,
+    NavigatorState,
+)
 from algorithms.navigation.odometry import Odometry, RobotCalibration
 from algorithms.navigation.percept import Percept
 
 __all__ = [
     "ArenaConventions",
+    "NavEvent",
     "Navigator",
+    "NavigatorEvent",
     "NavigatorState",
     "Odometry",
     "Percept",

@@ -81,6 +81,26 @@ class ArenaConventions:
     max_seek_m: float = 0.40
 
 
+class NavEvent(Enum):
+    """What a navigator reports to its robot's other parts (``Navigator.events``)."""
+
+    LEFT_VERTEX = "left the vertex"
+    VERTEX_DETECTED = "vertex detected"  # the left wall ended
+    ARRIVED = "arrived"  # on a vertex centre with its edges measured (also after a launch)
+    LOST = "lost"  # lost its line: needs help (the paper's robots were placed back by hand)
+
+
+@dataclass(frozen=True)
+class NavigatorEvent:
+    """One navigator event; ``reason`` says why for LOST."""
+
+    kind: NavEvent
+    reason: str = ""
+
+    def __str__(self) -> str:
+        return f"{self.kind.value}: {self.reason}" if self.reason else self.kind.value
+
+
 class NavigatorState(Enum):
     SCANNING = "scanning"
     AT_VERTEX = "at_vertex"  # edges known, waiting for depart()
@@ -113,7 +133,7 @@ class Navigator:
         self.state = NavigatorState.AT_VERTEX
         self.edge_angles: list[float] = []
         self.arrived_angle: float | None = None
-        self.events: list[str] = []
+        self.events: list[NavigatorEvent] = []
         self._plan: deque = deque()
         self._incoming: float | None = None
         self._scans = 0
@@ -137,7 +157,7 @@ class Navigator:
             (SeekLine(angle, self.speed, self.conv.max_seek_m), self._found_lane),
         ])
         self.state = NavigatorState.LEAVING
-        self.events.append("left_vertex")
+        self.events.append(NavigatorEvent(NavEvent.LEFT_VERTEX))
 
     def update(self, percept: Percept) -> tuple[float, float]:
         """Advance one control tick; return the ``(v, omega)`` command (m/s, rad/s)."""
@@ -221,7 +241,7 @@ class Navigator:
             self._wall_run_start = None
             if self._wall_seen and not self.vertex_detected:
                 self.vertex_detected = True
-                self.events.append("vertex_detected")
+                self.events.append(NavigatorEvent(NavEvent.VERTEX_DETECTED))
 
     def _lane_ended(self, lane: FollowLine) -> None:
         if not self.vertex_detected:
@@ -276,12 +296,12 @@ class Navigator:
             self.edge_angles = off_centre_correction(
                 angles, self.arrived_angle, self.cal.line_ahead_m)
         self.state = NavigatorState.AT_VERTEX
-        self.events.append("arrived")
+        self.events.append(NavigatorEvent(NavEvent.ARRIVED))
 
     def _lose(self, why: str) -> None:
         self.state = NavigatorState.LOST
         self._plan.clear()
-        self.events.append(f"lost: {why}")
+        self.events.append(NavigatorEvent(NavEvent.LOST, why))
 
 
 def frame_offset(measured: Sequence[float], stored: Sequence[float]) -> float:
