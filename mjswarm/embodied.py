@@ -76,7 +76,7 @@ from mjswarm.awareness import TableAwareness
 from mjswarm.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
 from mjswarm.faults import Fault
-from mjswarm.graphworld import ExplorationResult, make_minds
+from mjswarm.graphworld import ExplorationResult, make_minds, outcome
 from mjswarm.navigation import NavigationDriver, percepts
 from mjswarm.simulation import Simulation
 from mjswarm.stations import VertexStations
@@ -536,33 +536,12 @@ class EmbodiedExploration:
     # ------------------------------------------------------------------ metrics
     def result(self, wall: float = 0.0) -> EmbodiedResult:
         """The measurements so far (``wall``: wall-clock seconds spent, for the rates)."""
-        per_robot = [len(p) - 1 for p in self.paths]
-        map_edges: list[tuple[str, str]] = []
-        declared_by = declared_at = None
-        if self.declared is not None:
-            _, i, declared_at = self.declared
-            declared_by = i + 1
-            map_edges = sorted(
-                tuple(sorted((self.beacon_vertex[a], self.beacon_vertex[b])))
-                for a, b in self.minds[i].map_edges())
-        truth = {tuple(sorted(e)) for e in self.spec.edges}
         sim_time = self.sim.time_s
+        makespan = None if self.declared is None else max(len(p) - 1 for p in self.paths)
         return EmbodiedResult(
-            arena=self.spec.name,
-            strategy=getattr(self.minds[0], "name", type(self.minds[0]).__name__),
-            robots=len(self.minds),
-            root=self.spec.root,
-            edge_time="physics",
-            seed=self.seed,
-            completed=self.declared is not None,
-            makespan=max(per_robot) if self.declared is not None else None,
-            total_traversals=sum(per_robot),
-            traversals_per_robot=per_robot,
-            declared_by=declared_by,
-            declared_at=declared_at,
-            map_edges=map_edges,
-            map_correct=self.declared is not None and set(map_edges) == truth,
-            paths=self.paths,
+            **outcome(self.minds, self.declared, makespan, self.paths, self.beacon_vertex,
+                      {tuple(sorted(e)) for e in self.spec.edges}, arena=self.spec.name,
+                      root=self.spec.root, edge_time="physics", seed=self.seed),
             collisions=self.sim.collisions.count,
             speed_changes=sum(r.activations for r in self.rules),
             sim_time_s=sim_time,

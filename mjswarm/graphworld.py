@@ -26,7 +26,7 @@ from __future__ import annotations
 import heapq
 import itertools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 
 import networkx as nx
@@ -70,6 +70,37 @@ class ExplorationResult:
         d = asdict(self)
         d["map_edges"] = [list(e) for e in self.map_edges]
         return d
+
+
+def outcome(
+    minds: Sequence[Strategy], declared: tuple[float, int, str] | None,
+    makespan: float | None, paths: list[list[str]], beacon_vertex: Mapping[str, str],
+    true_edges: set[tuple[str, str]], **run,
+) -> dict:
+    """The :class:`ExplorationResult` fields every world computes the same way, given the
+    declaration ``(time, robot index, vertex)`` or None, the makespan, each robot's path,
+    where each beacon was dropped, the true edges (sorted pairs) and the run's own fields
+    (``arena``, ``root``, ``edge_time``, ``seed``). The declaring robot's map is
+    translated from beacon ids to arena vertices."""
+    per_robot = [len(p) - 1 for p in paths]
+    map_edges: list[tuple[str, str]] = []
+    if declared is not None:
+        map_edges = sorted(tuple(sorted((beacon_vertex[a], beacon_vertex[b])))
+                           for a, b in minds[declared[1]].map_edges())
+    return dict(
+        run,
+        strategy=getattr(minds[0], "name", type(minds[0]).__name__),
+        robots=len(minds),
+        completed=declared is not None,
+        makespan=makespan,
+        total_traversals=sum(per_robot),
+        traversals_per_robot=per_robot,
+        declared_by=None if declared is None else declared[1] + 1,
+        declared_at=None if declared is None else declared[2],
+        map_edges=map_edges,
+        map_correct=declared is not None and set(map_edges) == true_edges,
+        paths=paths,
+    )
 
 
 class GraphWorld:
@@ -183,33 +214,13 @@ class GraphWorld:
                 break
             else:
                 raise ValueError(f"robot {i + 1} answered an unknown decision {decision!r}")
-        map_edges: list[tuple[str, str]] = []
         if declared is not None:
-            t, i, _ = declared
             for j in range(k):  # traversals still under way at the declaration do not count
-                if arrival_time[j] > t:
+                if arrival_time[j] > declared[0]:
                     paths[j].pop()
-            map_edges = sorted(
-                tuple(sorted((beacon_vertex[a], beacon_vertex[b]))) for a, b in minds[i].map_edges()
-            )
-        per_robot = [len(p) - 1 for p in paths]
-        return ExplorationResult(
-            arena=arena,
-            strategy=getattr(minds[0], "name", type(minds[0]).__name__),
-            robots=k,
-            root=self.root,
-            edge_time=self.edge_time,
-            seed=seed,
-            completed=declared is not None,
-            makespan=None if declared is None else declared[0],
-            total_traversals=sum(per_robot),
-            traversals_per_robot=per_robot,
-            declared_by=None if declared is None else declared[1] + 1,
-            declared_at=None if declared is None else declared[2],
-            map_edges=map_edges,
-            map_correct=declared is not None and set(map_edges) == self.edges,
-            paths=paths,
-        )
+        return ExplorationResult(**outcome(
+            minds, declared, None if declared is None else declared[0], paths, beacon_vertex,
+            self.edges, arena=arena, root=self.root, edge_time=self.edge_time, seed=seed))
 
     def _clock(self, t: float) -> float:
         """Times are whole steps with unit edges; with length-proportional edges they are
