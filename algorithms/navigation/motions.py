@@ -20,7 +20,7 @@ MIN_TURN_RATE = 0.2
 #: A turn is done within this heading error (rad, 0.6 degrees).
 TURN_TOLERANCE = 0.01
 #: Drive slows down to ``DRIVE_GAIN * distance left`` (1/s), but not below DRIVE_MIN_SPEED
-#: (m/s): the wheels' speed ramp (the motor filter of ``models/spark_v.xml``, 0.1 s) then
+#: (m/s): the wheels' speed ramp (the motor filter of ``models/spark_v.xml``, 0.05 s) then
 #: coasts the robot at most half a millimetre past its goal.
 DRIVE_GAIN = 2.0
 DRIVE_MIN_SPEED = 0.005
