@@ -25,8 +25,8 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
   stands off-centre across it (:func:`off_centre_correction`). Scans turn
   counter-clockwise and clockwise in turn: each calibrates the odometry's track, but a
   residual scale error would add up over a long run's scans if they all turned one way
-  (with one direction a lone robot's heading drifted 12 degrees over the 260 legs of
-  ``lattice:10x10`` at 0.2 m/s, alternating 7; README, "Robustness");
+  (issue 13: a lone robot's heading drifted 12 degrees over the 260 legs of
+  ``lattice:10x10`` at 0.2 m/s scanning one way, 7 alternating, both before re-anchoring);
 * **re-anchoring** (:meth:`Navigator.reanchor`): at a vertex whose beacon already stores
   angles, the caller rotates the robot's frame onto them (:func:`frame_offset`);
 * **leaving**: sidestep from the vertex centre to the left of the chosen spoke by
