@@ -37,7 +37,7 @@ def main() -> None:
             radio = team.radio(r)
             tables = {v: ConnectivityTable(v, ref, max_forwards=2 if method == "tables-2" else None)
                       for v in g}
-            drive(radio, tables, lambda radio=radio: radio.pending == 0)
+            drive(radio, tables, lambda radio=radio: radio.last_batch == 0)
             msgs += radio.total_sent
             blocks = [c for c in nx.biconnected_components(g) if ref in c and len(c) >= 3]
             for v in g:

@@ -4,7 +4,8 @@ For each robot count N the benchmark builds one world (robots in a grid, each on
 floor strip, walls beside every row) and measures, in the same process and run:
 
 * ``realtime_factor``: simulated seconds per wall second of the full control loop
-  (:class:`BenchTeam`): every robot's line, IR, encoder and wheel-speed readings, its
+  (:func:`bench_loop`: one :class:`BenchRobot` controller per robot in a
+  :class:`~mjswarm.sparkworld.SparkWorld`, run by the one :class:`~mjswarm.loop.Loop`): every robot's line, IR, encoder and wheel-speed readings, its
   bearing sensor (+-60 degrees, 1 m, line of sight), a radio (range ``RADIO_RANGE_M``,
   links need line of sight both ways) on which every robot broadcasts a heartbeat every
   tick and reads its inbox, and per robot the seed-003 speed rule
@@ -26,18 +27,24 @@ import mujoco
 import numpy as np
 
 from algorithms.collision import CollisionRule, epsilons
+from algorithms.navigation.percept import LINE_THRESHOLD_M
+from algorithms.robot import Command, Controller, Message, Observation
 from mjswarm.awareness import sight_blocker
 from mjswarm.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
+from mjswarm.loop import Loop
 from mjswarm.radio import Radio
 from mjswarm.robot import DEFAULT_ROBOT_XML
 from mjswarm.simulation import Simulation
+from mjswarm.sparkworld import SparkWorld
 from mjswarm.world import FloorStrip, Pose2D, WallSegment, world_spec
 
 ROW_SPACING_M = 0.5
 COLUMN_SPACING_M = 0.6
 BENCH_SPEED_M_S = 0.1
 RADIO_RANGE_M = 1.0
+#: the line follower's turn rate when one side sensor sees the strip (rad/s)
+TURN_GAIN_RAD_S = 0.8
 
 
 @dataclass(frozen=True)
@@ -69,35 +76,33 @@ def bench_world(n: int, robot_xml: str = str(DEFAULT_ROBOT_XML), sensing: str = 
     return Simulation(world_spec(poses, strips, walls, robot_xml=robot_xml), sensing=sensing)
 
 
-class BenchTeam:
-    """The full per-tick loop of N robots: sensing, bearings, radio, speed rule, steering."""
+class BenchRobot(Controller):
+    """The bench's controller: hears its inbox and broadcasts a heartbeat every tick,
+    sets its speed with the seed-003 speed rule from its bearings and steers towards the
+    darker side with a proportional line follower on its own line sensors."""
 
-    def __init__(self, sim: Simulation) -> None:
-        self.sim = sim
-        self.bearing = BearingSensor(sim)
-        self.radio = Radio(range(sim.n), range_m=RADIO_RANGE_M, blocked=sight_blocker(sim))
-        self.rules = [CollisionRule(BENCH_SPEED_M_S, e, dt=sim.control_dt_s) for e in epsilons(sim.n)]
+    def __init__(self, rule: CollisionRule, line_sensor_height_m: float) -> None:
+        self.rule = rule
+        self.height_m = line_sensor_height_m
         self.heard = 0
 
-    def tick(self) -> None:
-        """Sense, communicate, decide and command every robot, then step the world once."""
-        sim = self.sim
-        self.radio.step(dict(enumerate(sim.poses()[:, :2])))
-        for i in range(sim.n):
-            self.heard += len(self.radio.receive(i))
-            self.radio.send(i, sim.step_count)
-        bearings = self.bearing.read()
-        speed = np.array([rule.update(seen) for rule, seen in zip(self.rules, bearings)])
-        sim.set_velocity(speed, line_following_turn(sim))
-        sim.step()
+    def step(self, observation: Observation) -> Command:
+        self.heard += len(observation.inbox)
+        line = observation.line_m
+        left = float(self.height_m - line[0] > LINE_THRESHOLD_M)
+        right = float(self.height_m - line[2] > LINE_THRESHOLD_M)
+        return Command(self.rule.update(observation.bearings), TURN_GAIN_RAD_S * (left - right),
+                       messages=(Message(observation.time_s),))
 
 
-def line_following_turn(sim: Simulation) -> np.ndarray:
-    """A proportional line follower over all robots (rad/s): turn towards the darker side."""
-    line = sim.readings()["line"]
+def bench_loop(sim: Simulation) -> Loop:
+    """The full per-tick loop of N robots (module docstring) on ``sim``."""
+    world = SparkWorld(sim, BearingSensor(sim))
+    world.attach_radio(Radio(range(sim.n), range_m=RADIO_RANGE_M, blocked=sight_blocker(sim)))
     height = sim.geometry.line_sensor_height_m
-    on = (height - line) > 0.001  # a strip under the sensor shortens the reading by 2 mm
-    return 0.8 * (on[:, 0].astype(float) - on[:, 2].astype(float))
+    robots = {i: BenchRobot(CollisionRule(BENCH_SPEED_M_S, e, dt=sim.control_dt_s), height)
+              for i, e in enumerate(epsilons(sim.n))}
+    return Loop(world, robots)
 
 
 def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROBOT_XML),
@@ -106,12 +111,11 @@ def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROB
     if sim_seconds <= 0:
         raise MjswarmError(f"benchmark duration must be positive, got {sim_seconds} s")
     sim = bench_world(n, robot_xml, sensing)
-    team = BenchTeam(sim)
-    team.tick()  # warm-up: one-time costs (loading the compiled ray loop) stay out of the timing
+    loop = bench_loop(sim)
+    loop.step()  # warm-up: one-time costs (loading the compiled ray loop) stay out of the timing
     ticks = max(1, round(sim_seconds / sim.control_dt_s))
     start = time.perf_counter()
-    for _ in range(ticks):
-        team.tick()
+    loop.run(max_ticks=ticks + 1)
     full_wall = time.perf_counter() - start
 
     bare = bench_world(n, robot_xml)

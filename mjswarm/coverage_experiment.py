@@ -50,6 +50,7 @@ import numpy as np
 from algorithms.maintenance.biconnected import PLACEMENTS, BiconnectedRobot, Params
 from algorithms.maintenance.regions import union_area
 from mjswarm.errors import MjswarmError
+from mjswarm.loop import Loop, LoopFunctions
 from mjswarm.openfloor import EmbodiedFloor, MotionWorld, PointWorld
 from mjswarm.robot import spark_v_geometry
 from mjswarm.radio import Radio
@@ -107,8 +108,12 @@ class CoverageResult:
         return data
 
 
-class CoverageRun:
-    """The experiment's loop functions: world, radio, minds, episodes.
+class CoverageRun(LoopFunctions):
+    """The experiment's loop functions: world, radio, robots, episodes.
+
+    One :class:`~mjswarm.loop.Loop` runs the :class:`BiconnectedRobot` controllers; this
+    object adds and removes robots between episodes and stops the loop when an episode
+    has settled.
 
     Args:
         cr: communication range / region diameter (> 1).
@@ -143,29 +148,36 @@ class CoverageRun:
                              v_max=spark_v_geometry().max_speed_m_s, clearance_m=clearance_m)
         self.rng = np.random.default_rng(seed)
         self.max_ticks = max_ticks
-        self.result = CoverageResult(self.cr, placement, world, seed, region_diameter_m,
-                                     self.params.link_m)
+        self.coverage_result = CoverageResult(self.cr, placement, world, seed, region_diameter_m,
+                                      self.params.link_m)
         starts = [(0.0, 0.0)] * MAX_ROBOTS
         absent = [False] * MAX_ROBOTS
+        tick = self.params.tick_s
         self.world: MotionWorld
         if world == "point":
-            self.world = PointWorld(starts, present=absent, seed=seed)
+            self.world = PointWorld(starts, present=absent, seed=seed, control_dt_s=tick)
         else:
             half = max(10.0, 3.0 * MAX_ROBOTS * self.params.link_m)
             self.world = EmbodiedFloor(starts, present=absent, seed=seed,
-                                       floor_half_size_m=half)
-        self.minds: dict[int, BiconnectedRobot] = {}
-        self.now = 0
+                                       floor_half_size_m=half, control_dt_s=tick)
+        self.world.attach_radio(Radio(range(MAX_ROBOTS), range_m=self.params.link_m))
+        self.loop = Loop(self.world, {}, [self])
+        self._ticks = 0
         for _ in range(START_ROBOTS):
             self._episode("add", -1)
+
+    @property
+    def minds(self) -> dict[int, BiconnectedRobot]:
+        """The team's controllers by robot id."""
+        return self.loop.controllers  # type: ignore[return-value]
 
     # -- episodes -------------------------------------------------------------------------
     def step_episode(self) -> Episode:
         """One random add or remove, run until it has settled."""
         n = len(self.minds)
         add = n == 0 or (n < MAX_ROBOTS and self.rng.random() < 0.5)
-        episode = self._episode("add" if add else "remove", len(self.result.episodes))
-        self.result.episodes.append(episode)
+        episode = self._episode("add" if add else "remove", len(self.coverage_result.episodes))
+        self.coverage_result.episodes.append(episode)
         return episode
 
     def run(self, episodes: int, progress: Callable[[], None] | None = None) -> CoverageResult:
@@ -173,10 +185,9 @@ class CoverageRun:
             self.step_episode()
             if progress:
                 progress()
-        self.result.sim_time_s = self.world.time_s
-        if isinstance(self.world, EmbodiedFloor):
-            self.result.collisions = int(self.world.sim.collisions.count)
-        return self.result
+        self.coverage_result.sim_time_s = self.world.time_s
+        self.coverage_result.collisions = self.world.contacts
+        return self.coverage_result
 
     def coverage(self) -> float | None:
         """S-coverage of the current regions (None for an empty team)."""
@@ -187,70 +198,60 @@ class CoverageRun:
         return union_area(centres, r) / (len(centres) * math.pi * r * r)
 
     def _episode(self, action: str, index: int) -> Episode:
-        radio_ids = sorted(self.minds)
-        leaving = None
+        world, radio = self.world, self.world.radio
+        sent_before = radio.total_sent
         if action == "add":
             robot = min(set(range(MAX_ROBOTS)) - set(self.minds))
-            self.world.place(robot, self._entry_point(), float(self.rng.uniform(-math.pi, math.pi)))
+            world.place(robot, self._entry_point(), float(self.rng.uniform(-math.pi, math.pi)))
             self.minds[robot] = BiconnectedRobot(robot, self.params)
-            radio_ids.append(robot)
         else:
-            robot = leaving = int(self.rng.choice(sorted(self.minds)))
+            robot = int(self.rng.choice(sorted(self.minds)))
             if len(self.minds) == 1:  # nobody to tell, nothing to repair
-                self.world.place(robot, None)
+                world.place(robot, None)
                 self.minds.pop(robot)
                 return Episode(index, action, robot, 0, None, 0, 0, 0, 0)
-        radio = Radio(sorted(radio_ids), range_m=self.params.link_m)
+            # its last broadcast, heard by its neighbours, then it is taken off the floor
+            radio.send(robot, self.minds[robot].leave().payload)
+            radio.step()
+            world.place(robot, None)
+            self.minds.pop(robot)
         before = {k: (m.moves_led, m.checks_led) for k, m in self.minds.items()}
-        if leaving is not None:
-            radio.move(self._positions())
-            radio.send(leaving, self.minds[leaving].leave().payload)
-        ticks = 0
-        while True:
-            radio.step(self._positions())
-            if leaving is not None:
-                radio.remove(leaving)
-                self.world.place(leaving, None)
-                before.pop(leaving)
-                self.minds.pop(leaving)
-                leaving = None
-            sensed = self.world.sense()
-            velocities = np.zeros((MAX_ROBOTS, 2))
-            for rid, mind in self.minds.items():
-                out, velocities[rid] = mind.tick(self.now, radio.receive(rid),
-                                                 radio.neighbors(rid), sensed[rid])
-                for message in out:
-                    radio.send(rid, message.payload, message.to)
-            self.world.step(velocities, self.params.tick_s)
-            self.now += 1
-            ticks += 1
-            if self._settled(radio):
-                break
-            if ticks >= self.max_ticks:
-                raise MjswarmError(f"episode {index} ({action} robot {robot}) did not settle "
-                                   f"within {self.max_ticks} ticks")
+        self._ticks = 0
+        self.loop.run()
         moves = sum(m.moves_led - before.get(k, (0, 0))[0] for k, m in self.minds.items())
         checks = sum(m.checks_led - before.get(k, (0, 0))[1] for k, m in self.minds.items())
-        return Episode(index, action, robot, len(self.minds), self.coverage(), ticks,
-                       radio.total_sent, moves, checks)
+        return Episode(index, action, robot, len(self.minds), self.coverage(), self._ticks,
+                       radio.total_sent - sent_before, moves, checks)
 
-    def _settled(self, radio: Radio) -> bool:
-        if radio.pending or any(m.busy for m in self.minds.values()):
+    # -- loop-function hooks ----------------------------------------------------------------
+    def after_step(self, loop: Loop) -> None:
+        self._ticks += 1
+
+    def should_stop(self, loop: Loop) -> bool:
+        """The episode has settled: nothing sent in the tick, nobody busy, all holding."""
+        if self._settled():
+            return True
+        if self._ticks >= self.max_ticks:
+            raise MjswarmError(f"episode did not settle within {self.max_ticks} ticks")
+        return False
+
+    def result(self, loop: Loop) -> CoverageResult:
+        return self.coverage_result
+
+    def _settled(self) -> bool:
+        if self.world.radio.last_batch or any(m.busy for m in self.minds.values()):
             return False
         truth = self.world.true_positions()
         return all(math.dist(truth[k], m.hold) <= self.params.tolerance_m
                    for k, m in self.minds.items())
-
-    def _positions(self) -> dict[int, np.ndarray]:
-        truth = self.world.true_positions()
-        return {k: truth[k] for k in range(MAX_ROBOTS) if self.world.present[k]}
 
     def _entry_point(self) -> tuple[float, float]:
         if not self.minds:
             return 0.0, 0.0
         host = self.minds[int(self.rng.choice(sorted(self.minds)))].hold
         a = self.rng.uniform(-math.pi, math.pi)
-        robots = list(self._positions().values())
+        truth = self.world.true_positions()
+        robots = [truth[k] for k in range(MAX_ROBOTS) if self.world.present[k]]
         offset = ENTRY_OFFSET_M
         while True:
             for turn in range(12):

@@ -1,58 +1,47 @@
-"""Embodied exploration: the graph strategies on MuJoCo robots (issue 5).
+"""Embodied exploration: the graph strategies on MuJoCo robots (issue 5), as loop functions.
 
-Every robot runs three pieces of its own mind, fed only by its own sensors:
-
-* a :class:`~algorithms.navigation.Navigator` (lane following, vertex detection by IR,
-  edge discovery by scanning the spokes, odometry),
-* an exploration :class:`~algorithms.exploration.Strategy` (the same code as the graph
-  world), called at every vertex arrival with the beacon there and the angles the robot
-  measured,
-* a :class:`~algorithms.collision.CollisionRule` (seed 003 Sec. 4) that sets its linear
-  speed from the bearings its bearing sensor reports.
-
-This module is the "loop functions" side (ARGoS's term): it owns the beacons, launches
-robots, records and measures. Choices it makes, beyond the paper:
+Every robot is an :class:`~algorithms.exploration.explorer.Explorer` controller
+(navigator, exploration strategy, collision rule, vertex entry, optionally a
+connectivity table), run in a :class:`~mjswarm.sparkworld.SparkWorld` by the one
+:class:`~mjswarm.loop.Loop`. :class:`EmbodiedExploration` is the experiment's loop
+functions (ARGoS's term): it owns the beacons and the vertex stations, launches robots,
+injects faults, measures and records. Choices it makes, beyond the paper:
 
 * **Beacons** are a store keyed by the arena's vertex (seed 003 emulated beacons with a
   central station over XBee, "separate information for each vertex"; so do we). A robot
-  reads and writes the beacon only during its vertex call, i.e. while it stands on the
-  vertex centre; the world finds which vertex that is from ground truth, as the station
-  knew which vertex was calling.
-* **The speed rule applies on edges** (following a lane, seed 003 Sec. 4 "traversing an
-  edge"); in the vertex area (turns, scans, the sidesteps between lane and vertex
-  centre, finding the lane) robots move at S and are kept apart by vertex entry. A robot
-  slowed by the rule while it leaves a vertex would keep that vertex's area occupied
-  (issue 13: a robot leaving ``v7`` of ``fig9`` at 3 mm/s, slowed for the robot that was
-  swapping vertices with it, was run into by it). Applied at the vertex
-  centre too, the rule's "beta = 0: stop" would stop a robot facing a robot on the next
-  vertex along its edge, which may be waiting to enter this vertex: a deadlock.
+  gets the beacon in its observation only while it stands on the vertex centre (within
+  ``ON_VERTEX_M``; the station knows who stands on its centre, as the paper's station
+  knew which vertex was calling), and only if the station granted it that vertex (or it
+  was launched there).
 * **Vertex entry** (our addition, needed once robots have bodies): a vertex area holds
-  one robot at a time; a robot decides on a vertex centre, asks the vertex stations for
-  the vertex at the far end of its edge and leaves once granted
-  (:mod:`mjswarm.stations`, which also explains why no circular wait can form).
-  ``--no-collision-avoidance`` turns this off together with the speed rule.
-* **Heading re-anchoring**: at a vertex whose beacon already stores angles
-  (``Strategy.stored_angles``), the robot rotates its heading frame onto them
-  (:func:`~algorithms.navigation.navigator.frame_offset`: the mean offset over all the
-  vertex's edges). Odometry drift then no longer accumulates over revisits, and every
-  robot keeps the frame of the beacons; ``heading_error_deg`` in the result is the
-  largest odometry heading error of any robot over the run (ground truth, never seen by
-  robots).
-* **Robots that stop** (lost their line, not on a vertex centre after arriving, angles
-  that match no beacon, a fault) release every vertex they hold, stay where they are as
-  obstacles (a vertex whose area the body still occupies stays closed) and are listed in ``stopped_robots`` with the reason and the time. A run ends
-  early, not completed, when no robot has reached a vertex for ``stall_timeout_s``
+  one robot at a time; the protocol is :mod:`algorithms.exploration.entry`, carried by
+  the stations' link (:class:`~mjswarm.radio.Uplink`, one tick each way, counted in
+  ``station_messages``), and the grants are :mod:`mjswarm.stations`' (which also
+  explains why no circular wait can form). ``--no-collision-avoidance`` turns this off
+  together with the speed rule.
+* **Robots that stop** (the explorer's reasons, or a fault) release every vertex they
+  hold, stay where they are as obstacles (a vertex whose area the body still occupies
+  stays closed) and are listed in ``stopped_robots`` with the reason and the time. A run
+  ends early, not completed, when no robot has reached a vertex for ``stall_timeout_s``
   (``ended_because``: ``"completed"``, ``"stalled"``, ``"all robots stopped"`` or
   ``"max time"``).
 * **Launching from the root**: robots wait in a depot outside the arena and are put on the
   root centre one at a time (as the paper's robots were placed by hand), in ``launch_order``,
   at least ``launch_interval_s`` apart, whenever the root is free. Each starts with compass
   heading 0 along the world's +x, the common reference direction of the incidence angles.
+* **Connectivity awareness** (``radio_range_m``): robots carry radios (range R, one tick of
+  latency, links blocked by walls) and each keeps a connectivity table of internally
+  disjoint access paths to R1 (seed 004). Its *belief* is ``biconnected`` when it has
+  two such paths; the *truth* (:func:`mjswarm.awareness.truth`) is whether it shares a
+  biconnected component of three or more with R1 in the radio graph; both are sampled
+  five times a second into ``radio_belief_agreement``. Robots in the depot or failed
+  are off the air.
 * **Metrics**: ``makespan`` is the largest number of edges any robot had traversed when
   completion was declared (the synchronous world's step count; seed 003 counts "edge
   traversals"), ``total_traversals`` the sum; ``collisions`` are robot-robot contact events
   (ground truth, never seen by robots); ``speed_changes`` the collision rule's activations
-  (eq. 27).
+  (eq. 27); ``heading_error_deg`` the largest odometry heading error of any robot, on
+  lanes and at vertex calls (ground truth).
 """
 
 from __future__ import annotations
@@ -66,19 +55,33 @@ import numpy as np
 from tqdm import tqdm
 
 from algorithms.collision import PAPER_SPEED_M_S, CollisionRule, epsilons
+from algorithms.connectivity import ConnectivityTable
 from algorithms.exploration import Beacon, Strategy
-from algorithms.exploration.base import AngleMismatch
-from algorithms.navigation import NavEvent, NavigatorState
+from algorithms.exploration.entry import (
+    STATION,
+    EntryDenied,
+    EntryGranted,
+    EntryRequest,
+    Halted,
+    LeftVertex,
+    VertexClear,
+)
+from algorithms.exploration.explorer import Explorer, VertexCall
+from algorithms.navigation import NavigatorState
 from mjswarm.arena import ArenaSpec
-from mjswarm.arena.geometry import LANE_OFFSET_M, VERTEX_CLEAR_RADIUS_M
 from mjswarm.arena.builder import arena_world_spec
-from mjswarm.awareness import TableAwareness
+from mjswarm.arena.geometry import LANE_OFFSET_M, VERTEX_CLEAR_RADIUS_M
+from mjswarm.awareness import BICONNECTED, NOT, sight_blocker
+from mjswarm.awareness import truth as awareness_truth
 from mjswarm.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
 from mjswarm.faults import Fault
 from mjswarm.graphworld import ExplorationResult, make_minds, outcome
-from mjswarm.navigation import NavigationDriver, percepts
+from mjswarm.loop import Loop, LoopFunctions
+from mjswarm.navigation import calibration, conventions
+from mjswarm.radio import Radio, Uplink
 from mjswarm.simulation import Simulation
+from mjswarm.sparkworld import SparkWorld
 from mjswarm.stations import VertexStations
 from mjswarm.world import Pose2D
 
@@ -169,6 +172,9 @@ class EmbodiedResult(ExplorationResult):
     radio_messages: int | None = None
     radio_max_messages_per_robot: int | None = None
     radio_belief_agreement: float | None = None
+    #: vertex-entry messages between robots and stations, both ways
+    #: (:mod:`algorithms.exploration.entry`)
+    station_messages: int = 0
 
 
 def same_lane_bearing(range_m: float) -> float:
@@ -183,8 +189,8 @@ def same_lane_bearing(range_m: float) -> float:
     return math.atan2(LANE_OFFSET_M / 2.0, range_m)
 
 
-class EmbodiedExploration:
-    """One embodied exploration run: build the world, step it, measure it."""
+class EmbodiedExploration(LoopFunctions):
+    """One embodied exploration run: build the world and the robots, run, measure."""
 
     def __init__(self, spec: ArenaSpec, minds: list[Strategy], config: EmbodiedConfig,
                  seed: int | None = None, recorder=None) -> None:
@@ -199,6 +205,8 @@ class EmbodiedExploration:
         eps = config.epsilons or epsilons(k)
         if len(eps) != k:
             raise MjswarmError(f"need {k} epsilons, got {len(eps)}")
+        if config.radio_range_m is not None and not config.radio_range_m > 0:
+            raise MjswarmError(f"radio range must be positive, got {config.radio_range_m} m")
         self.spec, self.minds, self.config, self.seed = spec, minds, config, seed
         self.recorder = recorder
         xs = [x for x, _ in spec.vertices.values()]
@@ -208,32 +216,42 @@ class EmbodiedExploration:
         self.sim = Simulation(arena_world_spec(spec, depot), seed=seed or 0,
                               line_noise_m=config.line_noise_m, ir_noise_m=config.ir_noise_m,
                               wheel_slip=config.wheel_slip)
-        if self.sim.geometry.max_speed_m_s < config.speed_m_s:
+        geometry = self.sim.geometry
+        if geometry.max_speed_m_s < config.speed_m_s:
             raise MjswarmError(
                 f"speed {config.speed_m_s} m/s exceeds the robot's top speed "
-                f"{self.sim.geometry.max_speed_m_s:.2f} m/s")
-        self.driver = NavigationDriver(self.sim, [0.0] * k, config.speed_m_s,
-                                       config.turn_rate_rad_s)
-        self.bearing = BearingSensor(
+                f"{geometry.max_speed_m_s:.2f} m/s")
+        bearing = BearingSensor(
             self.sim, math.radians(config.bearing_fov_deg), config.bearing_range_m,
             math.radians(config.bearing_noise_deg), seed=seed or 0)
-        self.rules = [CollisionRule(config.speed_m_s, e, dt=self.sim.control_dt_s,
-                                    same_lane=same_lane_bearing(config.bearing_range_m))
-                      for e in eps]
+        self.world = SparkWorld(self.sim, bearing, present=np.zeros(k, bool),
+                                beacon_at=self._beacon_at)
+        self.uplink = Uplink(STATION)
+        self.world.uplinks[STATION] = self.uplink
+        if config.radio_range_m is not None:
+            self.world.attach_radio(Radio(range(k), range_m=config.radio_range_m,
+                                          blocked=sight_blocker(self.sim)))
+        avoid = config.collision_avoidance
+        cal, conv = calibration(geometry), conventions(geometry)
+        self.robots = [
+            Explorer(mind, cal, conv, config.speed_m_s,
+                     CollisionRule(config.speed_m_s, e, dt=self.sim.control_dt_s,
+                                   same_lane=same_lane_bearing(config.bearing_range_m))
+                     if avoid else None,
+                     config.turn_rate_rad_s, config.idle_wait_s,
+                     ConnectivityTable(i, 0) if config.radio_range_m is not None else None,
+                     self.sim.control_dt_s)
+            for i, (mind, e) in enumerate(zip(minds, eps))]
         self.beacons = {v: Beacon() for v in spec.vertices}
         self.beacon_vertex: dict[str, str] = {}
         self.launch_queue = order
-        self.active = [False] * k
-        self.done = [False] * k
         self.dead = [False] * k  # failed by an injected fault: radio off too
-        self.waiting_since: list[float | None] = [None] * k  # IDLE
         self.stations = VertexStations(spec)
         #: each robot's vertex: the one it stands on or was granted; the one it is leaving
         self.target: list[str | None] = [None] * k
         self.leaving: list[str | None] = [None] * k
-        self._departure_angle: list[float] = [0.0] * k
         self.paths = [[spec.root] for _ in range(k)]
-        self.handled_events = [0] * k
+        self._calls_seen = [0] * k
         self.last_launch = -math.inf
         self.last_progress_s = 0.0
         self.declared: tuple[float, int, str] | None = None
@@ -243,18 +261,26 @@ class EmbodiedExploration:
         self.pending_faults = sorted(config.faults, key=lambda f: f.at_s)
         self.fault_log: list[dict] = []
         self.ended_because = "max time"
+        self.agree = self.samples = 0
         longest = max(math.dist(spec.vertices[u], spec.vertices[v]) for u, v in spec.edges)
         self.stall_timeout_s = (config.stall_timeout_s if config.stall_timeout_s is not None
                                 else max(STALL_MIN_S, STALL_EDGE_FACTOR * longest / config.speed_m_s))
-        self.awareness = None
-        if config.radio_range_m is not None:
-            if config.radio_range_m <= 0:
-                raise MjswarmError(f"radio range must be positive, got {config.radio_range_m} m")
-            self.awareness = TableAwareness(self.sim, config.radio_range_m)
         self._vertices = np.array(list(spec.vertices.values()))
         self._vertex_ids = list(spec.vertices)
         for fault in config.faults:
             fault.check(self)
+        self.loop = Loop(self.world, dict(enumerate(self.robots)), [self])
+
+    @property
+    def active(self) -> list[bool]:
+        """Which robots have been launched."""
+        return [bool(p) or d for p, d in zip(self.world.present, self.dead)]
+
+    @property
+    def done(self) -> list[bool]:
+        """Which robots are finished: stopped, failed or declared."""
+        return [r.halted is not None or r.declared or d
+                for r, d in zip(self.robots, self.dead)]
 
     # ------------------------------------------------------------------ loop
     def run(self, progress: bool = False) -> EmbodiedResult:
@@ -287,7 +313,11 @@ class EmbodiedExploration:
         self._event(None, f"run ended: {self.ended_because}")
         if log:
             print(self._status(time.perf_counter() - start), file=sys.stderr, flush=True)
-        return self.result(time.perf_counter() - start)
+        return self.result(wall=time.perf_counter() - start)
+
+    def step(self) -> None:
+        """One control tick of the loop."""
+        self.loop.step()
 
     def _traversals(self) -> int:
         return sum(len(p) - 1 for p in self.paths)
@@ -311,69 +341,90 @@ class EmbodiedExploration:
             return False
         return True
 
-    def step(self) -> None:
-        """One control tick: faults, launch, grant, sense, decide, act, simulate."""
-        sim, cfg = self.sim, self.config
+    # ------------------------------------------------------------------ hooks
+    def before_step(self, loop: Loop) -> None:
+        """Faults, launches, the stations' mail, grants."""
         self._inject_faults()
         self._launch_if_free()
-        if cfg.collision_avoidance:
+        for message in self.uplink.receive():
+            self._station_receives(message.sender, message.payload)
+        if self.config.collision_avoidance:
             for i, vertex in self.stations.grant():
-                self._depart(i, vertex)
-        speeds = np.zeros(sim.n)
-        bearings = self.bearing.read() if cfg.collision_avoidance else None
-        v = np.zeros(sim.n)
-        w = np.zeros(sim.n)
-        poses = sim.poses()
-        for i, (nav, percept) in enumerate(zip(self.driver.navigators, percepts(sim))):
-            if not self.active[i] or self.done[i]:
-                continue
-            vi, wi = nav.update(percept)
-            self._handle_events(i)
-            if self.done[i]:
-                continue
-            if nav.state is NavigatorState.ON_EDGE:
-                self._measure_heading(i, poses[i, 2])
-            speed = cfg.speed_m_s
-            if cfg.collision_avoidance:
-                if nav.on_lane:  # the rule governs edge traversals
-                    speed = self.rules[i].update(bearings[i])
-                else:
-                    self.rules[i].forget_bearings()
-                if self.leaving[i] is not None and nav.in_corridor:  # clear of it
-                    self.stations.release(i, self.leaving[i])
-                    self.leaving[i] = None
-                if nav.at_vertex_area and self.target[i] in self.leaving:
-                    speed = 0.0  # its previous holder is still leaving (a cycle's grant)
-            if speed != self._last_speed[i] and nav.on_lane:
-                self._event(i, f"R{i + 1} speed {self._last_speed[i]:.3f} -> {speed:.3f} m/s")
-            self._last_speed[i] = speed
-            factor = speed / cfg.speed_m_s
-            if vi != 0.0:  # translations run at the rule's speed; turns in place do not
-                vi, wi = vi * factor, wi * factor
-            v[i], w[i], speeds[i] = vi, wi, speed
-        sim.set_velocity(v, w)
-        sim.step()
-        if self.awareness is not None:
-            self._radio_tick()
+                self.leaving[i], self.target[i] = self.target[i], vertex
+                busy = any(v == vertex for j, v in enumerate(self.leaving) if j != i)
+                self.uplink.reply(i, EntryGranted(clear=not busy))
+                self._event(i, f"R{i + 1} granted {vertex}")
+
+    def after_act(self, loop: Loop, i: int) -> None:
+        """What robot ``i`` did this tick, for the metrics and the recording."""
+        robot = self.robots[i]
+        nav = robot.nav
+        if nav.state is NavigatorState.ON_EDGE:
+            self._measure_heading(i)
+        for call in robot.calls[self._calls_seen[i]:]:
+            self._vertex_call(i, call)
+        self._calls_seen[i] = len(robot.calls)
+        if robot.halted is not None and not any(s["robot"] == i + 1 for s in self.stopped):
+            self._stopped(i, robot.halted)
+        if robot.speed_m_s != self._last_speed[i] and nav.on_lane:
+            self._event(i, f"R{i + 1} speed {self._last_speed[i]:.3f} -> "
+                           f"{robot.speed_m_s:.3f} m/s")
+        self._last_speed[i] = robot.speed_m_s
+
+    def after_step(self, loop: Loop) -> None:
+        sim = self.sim
+        if self.world.radio is not None and sim.step_count % 10 == 0:
+            self._sample_beliefs()
         if self.recorder is not None:
             readings = sim.readings()
+            bearings = self.world.bearing_readings()
             self.recorder.log_tick(sim.step_count, sim.time_s, sim.poses(), readings["line"],
-                                   readings["ir"], speeds,
-                                   [list(b.items()) for b in bearings] if bearings else
-                                   [[] for _ in range(sim.n)],
+                                   readings["ir"], np.array(self._last_speed),
+                                   [list(b.items()) for b in bearings],
                                    readings["encoder"], readings["battery"])
 
-    # ------------------------------------------------------------------ robots
-    def _radio_tick(self) -> None:
-        """Tables follow the moving radio graph; beliefs sampled 5 times a second."""
-        aware = self.awareness
-        aware.step(np.array(self.active) & ~np.array(self.dead))
-        if self.sim.step_count % 10:
-            return
-        beliefs, truth = aware.sample()
-        if self.recorder is not None:
-            edges = [tuple(e) for e in aware.radio.graph().edges]
-            self.recorder.log_radio(self.sim.step_count, self.sim.time_s, edges, beliefs, truth)
+    def should_stop(self, loop: Loop) -> bool:
+        return self.finished()
+
+    # ------------------------------------------------------------------ stations
+    def _beacon_at(self, i: int) -> Beacon | None:
+        """The beacon robot ``i`` can read now: its vertex's, if it stands on the centre
+        and the station there granted it the vertex (or launched it there)."""
+        vertex, distance = self._nearest_vertex(i)
+        if distance >= ON_VERTEX_M:
+            return None
+        if self.config.collision_avoidance and self.target[i] != vertex:
+            return None
+        return self.beacons[vertex]
+
+    def _station_receives(self, i: int, payload) -> None:
+        if isinstance(payload, EntryRequest):
+            vertex = self.target[i]
+            ahead, off = self.stations.edge_towards(vertex, payload.angle_rad)
+            if off > DEPARTURE_TOLERANCE_RAD:
+                self.uplink.reply(i, EntryDenied(
+                    f"its departure angle at {vertex} is {math.degrees(off):.0f} deg from "
+                    "every edge there"))
+                return
+            self.stations.request(i, vertex, ahead, self.sim.time_s)
+        elif isinstance(payload, LeftVertex):
+            left, self.leaving[i] = self.leaving[i], None
+            self.stations.release(i, left)
+            for j, v in enumerate(self.target):
+                if j != i and v == left and left not in self.leaving:
+                    self.uplink.reply(j, VertexClear())
+        elif isinstance(payload, Halted):
+            self._release(i)
+
+    def _release(self, i: int) -> None:
+        """Robot ``i`` stopped for good: its holds go; a station whose vertex area the
+        body still occupies keeps the vertex closed (it sees the body, as it sees who
+        stands on its centre)."""
+        self.stations.release_all(i)
+        vertex, distance = self._nearest_vertex(i)
+        if distance < VERTEX_CLEAR_RADIUS_M:
+            self.stations.occupy(i, vertex)
+        self.leaving[i] = None
 
     def _launch_if_free(self) -> None:
         if not self.launch_queue:
@@ -388,118 +439,71 @@ class EmbodiedExploration:
         if self.config.collision_avoidance and self.spec.root in self.stations.holder:
             return
         i = self.launch_queue.pop(0)
-        self.sim.place_robot(i, Pose2D(root[0], root[1], 0.0))
-        self.active[i] = True
+        self.world.place(i, Pose2D(root[0], root[1], 0.0))
         self.last_launch = self.last_progress_s = self.sim.time_s
         if self.config.collision_avoidance:
             self.stations.occupy(i, self.spec.root)
         self.target[i] = self.spec.root
-        self.driver.navigators[i].begin_at_vertex()
+        self.robots[i].reset()
         self._event(i, f"R{i + 1} launched at {self.spec.root}")
 
-    def _handle_events(self, i: int) -> None:
-        nav = self.driver.navigators[i]
-        new = nav.events[self.handled_events[i]:]
-        self.handled_events[i] = len(nav.events)
-        for event in new:
-            if event.kind is NavEvent.ARRIVED:
-                self.rules[i].crossed_vertex()  # eq. (34)
-                # the scan right after a launch is no arrival: the robot came by no edge
-                self._at_vertex(i, arrived=nav.arrived_angle is not None)
-            elif event.kind is NavEvent.LOST:
-                self._stop(i, str(event))
-        waiting = self.waiting_since[i]
-        if waiting is not None and self.sim.time_s - waiting >= self.config.idle_wait_s:
-            self.waiting_since[i] = None
-            self._at_vertex(i, arrived=False)
-
-    def _at_vertex(self, i: int, arrived: bool) -> None:
-        """The strategy's vertex call: beacon in, decision out."""
-        nav = self.driver.navigators[i]
-        vertex = self._vertex_under(i)
-        if vertex is None:
-            self._stop(i, "not on a vertex centre after arriving")
-            return
-        if vertex != self.target[i]:
-            self._stop(i, f"arrived at {vertex}, not at {self.target[i]} where it was heading")
-            return
-        if arrived:
+    # ------------------------------------------------------------------ robots
+    def _vertex_call(self, i: int, call: VertexCall) -> None:
+        vertex = self._nearest_vertex(i)[0]  # where it stands (its beacon was served)
+        if call.arrived:
             self.paths[i].append(vertex)
             self.last_progress_s = self.sim.time_s
             self._event(i, f"R{i + 1} at {vertex}")
-        beacon = self.beacons[vertex]
-        mind = self.minds[i]
-        try:
-            decision = mind.on_vertex(beacon, nav.edge_angles,
-                                      nav.arrived_angle if arrived else None)
-        except AngleMismatch as exc:  # its heading reference is broken (e.g. after a crash)
-            self._stop(i, f"its angles match no edge of the beacon at {vertex}: {exc}")
-            return
-        except ValueError as exc:  # a beacon it cannot reconcile (e.g. a wiped one)
-            self._stop(i, f"its strategy failed at {vertex}: {exc}")
-            return
-        if mind.stored_angles is not None:  # re-anchoring (see the module docstring)
-            nav.reanchor(mind.stored_angles)
-        self._measure_heading(i, self.sim.poses()[i, 2])
-        if beacon.id is not None:
-            self.beacon_vertex.setdefault(beacon.id, vertex)
+        self._measure_heading(i)
+        if call.beacon.id is not None:
+            self.beacon_vertex.setdefault(call.beacon.id, vertex)
         if self.recorder is not None:
-            self._record_vertex_call(i, vertex, beacon)
-        if decision.action == "go":
-            self._ask_to_leave(i, vertex, decision.angle)
-        elif decision.action == "idle":
-            self.waiting_since[i] = self.sim.time_s
-        elif decision.action == "done":
+            self._record_vertex_call(i, vertex, call.beacon)
+        if call.decision.action == "done":
             self.declared = (self.sim.time_s, i, vertex)
-            self.done[i] = True
             self._event(i, f"R{i + 1} declares completion at {vertex}")
             self._event(None, f"R{i + 1} declared completion at {vertex}")
-        else:
-            raise ValueError(f"robot {i + 1} answered an unknown decision {decision!r}")
+        elif call.decision.action == "go" and not self.config.collision_avoidance:
+            self.target[i] = self.stations.edge_towards(vertex, call.decision.angle)[0]
 
-    def _measure_heading(self, i: int, true_yaw: float) -> None:
+    def _stopped(self, i: int, reason: str) -> None:
+        self.stopped.append({"robot": i + 1, "reason": reason, "at_s": round(self.sim.time_s, 2)})
+        self._event(i, f"R{i + 1} stopped: {reason}")
+
+    def fail(self, i: int, reason: str) -> None:
+        """Robot ``i`` fails (a fault): it stops where it is, off the air, and its holds
+        go as for any robot that stops."""
+        robot = self.robots[i]
+        if robot.halted is None and not robot.declared and not self.dead[i]:
+            robot.halted = reason
+            self._stopped(i, reason)
+        self.dead[i] = True
+        if i in self.launch_queue:  # not launched yet: it never will be
+            self.launch_queue.remove(i)
+            return
+        self.loop.halt(i)
+        self.world.set_on_air(i, False)
+        self._release(i)
+
+    def _measure_heading(self, i: int) -> None:
         """Track ``heading_error_deg``: sampled where the heading is in use, on a lane and
         at vertex calls (mid-scan the odometry over-reads rotation until the scan's own
         calibration corrects it)."""
-        error = abs(math.remainder(self.driver.navigators[i].odometry.theta - true_yaw,
-                                   2 * math.pi))
+        true_yaw = self.sim.poses()[i, 2]
+        error = abs(math.remainder(self.robots[i].nav.odometry.theta - true_yaw, 2 * math.pi))
         self.heading_error_rad = max(self.heading_error_rad, error)
 
-    def _ask_to_leave(self, i: int, vertex: str, angle: float) -> None:
-        """Vertex entry, step 1: the robot names its edge by its angle; the stations find
-        the vertex at its far end and queue the request (:mod:`mjswarm.stations`)."""
-        nav = self.driver.navigators[i]
-        self._departure_angle[i] = min(
-            nav.edge_angles, key=lambda a: abs(math.remainder(a - angle, 2 * math.pi)))
-        ahead, off = self.stations.edge_towards(vertex, angle)
-        if off > DEPARTURE_TOLERANCE_RAD:
-            self._stop(i, f"its departure angle at {vertex} is {math.degrees(off):.0f} deg "
-                          "from every edge there")
-            return
-        if not self.config.collision_avoidance:
-            self._depart(i, ahead)
-            return
-        self.stations.request(i, vertex, ahead, self.sim.time_s)
-
-    def _depart(self, i: int, ahead: str) -> None:
-        """Entry granted: leave along the chosen spoke towards ``ahead``."""
-        self.leaving[i], self.target[i] = self.target[i], ahead
-        self.driver.navigators[i].depart(self._departure_angle[i])
-
-    def _stop(self, i: int, reason: str) -> None:
-        """Robot ``i`` stops for good: it releases its holds and stays as an obstacle. A
-        station whose vertex area the body still occupies keeps the vertex closed (it
-        sees the body, as it sees who stands on its centre)."""
-        self.done[i] = True
-        self.stations.release_all(i)
-        xy = self.sim.poses()[i, :2]
-        d = np.hypot(*(self._vertices - xy).T)
-        j = int(np.argmin(d))
-        if d[j] < VERTEX_CLEAR_RADIUS_M:
-            self.stations.occupy(i, self._vertex_ids[j])
-        self.leaving[i] = None
-        self.stopped.append({"robot": i + 1, "reason": reason, "at_s": round(self.sim.time_s, 2)})
-        self._event(i, f"R{i + 1} stopped: {reason}")
+    def _sample_beliefs(self) -> None:
+        """Tables' beliefs against the truth, for R2..RK (R1 is the reference)."""
+        radio = self.world.radio
+        truth = awareness_truth(radio.graph(), 0, range(1, len(self.robots)))
+        beliefs = {i: BICONNECTED if self.robots[i].table.is_doubly_connected() else NOT
+                   for i in truth}
+        self.samples += len(truth)
+        self.agree += sum(beliefs[i] == truth[i] for i in truth)
+        if self.recorder is not None:
+            self.recorder.log_radio(self.sim.step_count, self.sim.time_s,
+                                    [tuple(e) for e in radio.graph().edges], beliefs, truth)
 
     def _inject_faults(self) -> None:
         """Apply the faults whose time has come (:mod:`mjswarm.faults`), at the control
@@ -522,35 +526,36 @@ class EmbodiedExploration:
         nodes.setdefault(vertex, self.spec.vertices[vertex])
         self.recorder.log_explored_graph(step, now, i, nodes, edges)
 
-    def _vertex_under(self, i: int) -> str | None:
-        """The vertex whose centre robot ``i`` stands on (the station's knowledge)."""
-        xy = self.sim.poses()[i, :2]
-        d = np.hypot(*(self._vertices - xy).T)
+    def _nearest_vertex(self, i: int) -> tuple[str, float]:
+        """The vertex nearest to robot ``i`` and its distance (m): what the stations see."""
+        d = np.hypot(*(self._vertices - self.sim.poses()[i, :2]).T)
         j = int(np.argmin(d))
-        return self._vertex_ids[j] if d[j] < ON_VERTEX_M else None
+        return self._vertex_ids[j], float(d[j])
 
     def _event(self, i: int | None, text: str) -> None:
         if self.recorder is not None:
             self.recorder.log_event(self.sim.step_count, self.sim.time_s, text, i)
 
     # ------------------------------------------------------------------ metrics
-    def result(self, wall: float = 0.0) -> EmbodiedResult:
+    def result(self, loop: Loop | None = None, wall: float = 0.0) -> EmbodiedResult:
         """The measurements so far (``wall``: wall-clock seconds spent, for the rates)."""
         sim_time = self.sim.time_s
         makespan = None if self.declared is None else max(len(p) - 1 for p in self.paths)
+        radio = self.world.radio
         return EmbodiedResult(
             **outcome(self.minds, self.declared, makespan, self.paths, self.beacon_vertex,
                       {tuple(sorted(e)) for e in self.spec.edges}, arena=self.spec.name,
                       root=self.spec.root, edge_time="physics", seed=self.seed),
             collisions=self.sim.collisions.count,
-            speed_changes=sum(r.activations for r in self.rules),
+            speed_changes=sum(r.rule.activations for r in self.robots if r.rule is not None),
             sim_time_s=sim_time,
             wall_time_s=wall,
             realtime_factor=sim_time / wall if wall > 0 else math.inf,
-            radio_messages=None if self.awareness is None else self.awareness.radio.total_sent,
-            radio_max_messages_per_robot=(None if self.awareness is None
-                                          else max(self.awareness.radio.sent.values())),
-            radio_belief_agreement=None if self.awareness is None else self.awareness.agreement,
+            radio_messages=None if radio is None else radio.total_sent,
+            radio_max_messages_per_robot=None if radio is None else max(radio.sent.values()),
+            radio_belief_agreement=(self.agree / self.samples if radio is not None
+                                    and self.samples else None),
+            station_messages=self.uplink.sent_up + self.uplink.sent_down,
             ended_because=self.ended_because,
             stopped_robots=list(self.stopped),
             heading_error_deg=round(math.degrees(self.heading_error_rad), 3),

@@ -49,11 +49,7 @@ class RobotFailure:
             raise MjswarmError(f"fault {self}: there are robots 1..{len(run.minds)}")
 
     def apply(self, run: EmbodiedExploration) -> None:
-        run.dead[self.robot] = True
-        if not run.done[self.robot]:
-            run._stop(self.robot, f"failed (fault {self})")
-        if self.robot in run.launch_queue:  # not launched yet: it never will be
-            run.launch_queue.remove(self.robot)
+        run.fail(self.robot, f"failed (fault {self})")
 
     def __str__(self) -> str:
         return f"robot:{self.robot + 1}@{self.at_s:g}"
@@ -87,11 +83,11 @@ class RadioBlackout:
     def check(self, run: EmbodiedExploration) -> None:
         if self.end_s <= self.at_s:
             raise MjswarmError(f"fault {self}: the blackout must end after it starts")
-        if run.awareness is None:
+        if run.config.radio_range_m is None:
             raise MjswarmError(f"fault {self} needs robots with radios (--radio-range)")
 
     def apply(self, run: EmbodiedExploration) -> None:
-        run.awareness.radio.blackout = True
+        run.world.radio.blackout = True
         run.pending_faults.append(_BlackoutEnd(self.end_s))
         run.pending_faults.sort(key=lambda f: f.at_s)
 
@@ -106,7 +102,7 @@ class _BlackoutEnd:
     at_s: float
 
     def apply(self, run: EmbodiedExploration) -> None:
-        run.awareness.radio.blackout = False
+        run.world.radio.blackout = False
 
     def __str__(self) -> str:
         return f"radio back at {self.at_s:g}"

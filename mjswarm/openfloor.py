@@ -1,18 +1,24 @@
 """Open-floor worlds for the connectivity-maintenance experiments (seeds 001 and 002).
 
-Two worlds with one interface, :class:`MotionWorld`, so the same algorithm code runs on
-MuJoCo robots (:class:`EmbodiedFloor`) and on kinematic points (:class:`PointWorld`):
+Two :class:`~mjswarm.loop.World` s with one implementation, :class:`MotionWorld`, so the
+same controllers run on MuJoCo robots (:class:`EmbodiedFloor`) and on kinematic points
+(:class:`PointWorld`):
 
-* robots take **planar velocity commands** (m/s, world frame) and follow them with the
-  unicycle tracker of :mod:`algorithms.motion` within the Spark V's limits
-  (the robot model's top speed, ``omega_max``);
+* robots command **planar velocities** (m/s, world frame; ``Command.velocity_m_s``) that
+  the unicycle tracker of :mod:`algorithms.motion` follows within the Spark V's limits
+  (the robot model's top speed, ``omega_max``), or ``(v, omega)`` directly;
 * robots **sense their own position and heading** through a positioning sensor (the
   papers assume robots know their positions; think UWB or motion capture) with optional
-  Gaussian noise; controllers use :meth:`MotionWorld.sense` only;
+  Gaussian noise (``Observation.pose``);
+* with ``detection_range_m``, a **range-and-bearing sensor** reports every present robot
+  within that range (seed 001: "the robots can identify other robots in range d_s"):
+  exact range (m) and bearing (rad, in the observer's frame) from the true poses, and the
+  signal that robot last showed (``Command.signal``; seed 001's robots tell roles apart,
+  our choice is that each shows its role, as an LED colour would);
 * robots can be **added and removed** (seed 002's episodes): an absent robot waits in a
   depot outside the floor (embodied) and is invisible to the radio and the sensors.
 
-Ground truth (:meth:`MotionWorld.true_positions`) is for metrics, the radio and tests.
+Ground truth (:meth:`MotionWorld.true_positions`) is for loop functions, metrics and tests.
 """
 
 from __future__ import annotations
@@ -24,15 +30,17 @@ from collections.abc import Sequence
 import numpy as np
 
 from algorithms.motion import track_velocity
+from algorithms.robot import Command, Detection, Observation
 from mjswarm.errors import MjswarmError
+from mjswarm.loop import World
 from mjswarm.robot import spark_v_geometry
 
 #: The turn rate we allow the tracker (rad/s); the top speed is the robot model's.
 OMEGA_MAX_RAD_S = 2.0
 
 
-class MotionWorld(ABC):
-    """N robots on an open floor, driven by planar velocity commands.
+class MotionWorld(World, ABC):
+    """N robots on an open floor (module docstring).
 
     Args:
         positions: start positions (m), one per robot; ``present`` says which are on the
@@ -40,11 +48,14 @@ class MotionWorld(ABC):
         seed: seeds the position-sensor noise.
         position_noise_m, heading_noise_rad: standard deviations of the positioning sensor.
         omega_max_rad_s: turn-rate cap of the velocity tracker (a paper may set its own).
+        control_dt_s: the control period (s) of :meth:`step`.
+        detection_range_m: range of the range-and-bearing sensor (m); None: no sensor.
     """
 
     def __init__(self, positions: Sequence[tuple[float, float]], present: Sequence[bool] | None,
                  seed: int, position_noise_m: float, heading_noise_rad: float,
-                 omega_max_rad_s: float = OMEGA_MAX_RAD_S) -> None:
+                 omega_max_rad_s: float = OMEGA_MAX_RAD_S, control_dt_s: float = 0.1,
+                 detection_range_m: float | None = None) -> None:
         if len(positions) < 1:
             raise MjswarmError("an open-floor world needs at least one robot")
         if position_noise_m < 0 or heading_noise_rad < 0:
@@ -56,11 +67,20 @@ class MotionWorld(ABC):
         if omega_max_rad_s <= 0:
             raise MjswarmError(f"turn-rate cap must be positive, got {omega_max_rad_s} rad/s")
         self.omega_max_rad_s = omega_max_rad_s
-        self.time_s = 0.0
+        if not control_dt_s > 0:
+            raise MjswarmError(f"control period must be positive, got {control_dt_s} s")
+        self.control_dt_s = control_dt_s
+        self.detection_range_m = detection_range_m
+        self._time_s = 0.0
+        self._commands: list[Command] = [Command()] * self.n
+        self.signals: list = [None] * self.n
+        self.uplinks = {}
+        self._sensed: np.ndarray | None = None  # this tick's positioning-sensor readings
+        self._detections: list[dict] | None = None
 
-    @abstractmethod
-    def true_poses(self) -> np.ndarray:
-        """Ground truth, shape (N, 3): x, y (m), yaw (rad). Not for controllers."""
+    @property
+    def time_s(self) -> float:
+        return self._time_s
 
     @abstractmethod
     def _advance(self, v: np.ndarray, omega: np.ndarray, duration_s: float) -> None:
@@ -82,16 +102,60 @@ class MotionWorld(ABC):
             poses[:, 2] += self.rng.normal(0.0, self.heading_noise_rad, self.n)
         return poses
 
-    def step(self, velocities: np.ndarray, duration_s: float) -> None:
-        """Follow planar velocities (m/s, shape (N, 2)) for ``duration_s`` seconds."""
-        velocities = np.asarray(velocities, float).reshape(self.n, 2)
+    # -- the World surface ---------------------------------------------------------------
+    def observe(self, i: int) -> Observation:
+        """Robot ``i``'s positioning sensor, range-and-bearing sensor and radio."""
+        if self._sensed is None:  # one reading of every sensor per tick
+            self._sensed = self.sense()
+        inbox, neighbors = self._inbox(i)
+        return Observation(i, self._time_s, pose=tuple(self._sensed[i].tolist()),
+                           detections=self._detected(i), inbox=inbox, neighbors=neighbors)
+
+    def act(self, i: int, command: Command) -> None:
+        self._commands[i] = command
+        if command.signal is not None:
+            self.signals[i] = command.signal
+        self._send(i, command.messages)
+
+    def step(self) -> None:
+        """Follow every present robot's command for one control period, then the radio."""
         sensed = self.sense()
         v_max = spark_v_geometry().max_speed_m_s
-        commands = [track_velocity(sensed[i, 2], velocities[i], v_max, self.omega_max_rad_s)
-                    if self.present[i] else (0.0, 0.0) for i in range(self.n)]
-        v, omega = (np.array(c) for c in zip(*commands))
-        self._advance(v, omega, duration_s)
-        self.time_s += duration_s
+        v, omega = np.zeros(self.n), np.zeros(self.n)
+        for i, c in enumerate(self._commands):
+            if not self.present[i]:
+                continue
+            if c.velocity_m_s is not None:
+                v[i], omega[i] = track_velocity(sensed[i, 2], np.asarray(c.velocity_m_s, float),
+                                                v_max, self.omega_max_rad_s)
+            else:
+                v[i], omega[i] = c.v_m_s, c.omega_rad_s
+        self._advance(v, omega, self.control_dt_s)
+        self._time_s += self.control_dt_s
+        self._sensed = self._detections = None
+        self._radio_step()
+
+    def show(self, i: int, signal) -> None:
+        """The experimenter sets what robot ``i`` shows (e.g. its initial role)."""
+        self.signals[i] = signal
+
+    def _detected(self, i: int) -> dict[int, Detection]:
+        if self.detection_range_m is None:
+            return {}
+        if self._detections is None:
+            poses = self.true_poses()
+            here = np.flatnonzero(self.present)
+            d = poses[here, None, :2] - poses[None, here, :2]  # d[a, b] = x_a - x_b
+            dist = np.hypot(d[..., 0], d[..., 1])
+            self._detections = [{} for _ in range(self.n)]
+            for a, b in zip(*np.nonzero(dist <= self.detection_range_m)):
+                if a == b:
+                    continue
+                i_, k = int(here[a]), int(here[b])
+                bearing = math.remainder(math.atan2(-d[a, b, 1], -d[a, b, 0]) - poses[i_, 2],
+                                         2 * math.pi)
+                self._detections[i_][k] = Detection(float(dist[a, b]), bearing, self.signals[k])
+        return self._detections[i]
 
 
 class PointWorld(MotionWorld):
@@ -99,9 +163,10 @@ class PointWorld(MotionWorld):
 
     def __init__(self, positions, present=None, seed=0, position_noise_m=0.0,
                  heading_noise_rad=0.0, dt_s: float = 0.02,
-                 omega_max_rad_s: float = OMEGA_MAX_RAD_S) -> None:
+                 omega_max_rad_s: float = OMEGA_MAX_RAD_S, control_dt_s: float = 0.1,
+                 detection_range_m: float | None = None) -> None:
         super().__init__(positions, present, seed, position_noise_m, heading_noise_rad,
-                         omega_max_rad_s)
+                         omega_max_rad_s, control_dt_s, detection_range_m)
         self.dt_s = dt_s
         self._poses = np.zeros((self.n, 3))
         self._poses[:, :2] = np.asarray(positions, float)
@@ -113,6 +178,9 @@ class PointWorld(MotionWorld):
         self.present[i] = xy is not None
         if xy is not None:
             self._poses[i] = (xy[0], xy[1], yaw)
+        self._sensed = self._detections = None
+        self.set_on_air(i, xy is not None)
+        self.relink()
 
     def _advance(self, v, omega, duration_s) -> None:
         for _ in range(max(1, round(duration_s / self.dt_s))):
@@ -131,12 +199,13 @@ class EmbodiedFloor(MotionWorld):
 
     def __init__(self, positions, present=None, seed=0, position_noise_m=0.0,
                  heading_noise_rad=0.0, floor_half_size_m: float = 10.0,
-                 omega_max_rad_s: float = OMEGA_MAX_RAD_S) -> None:
+                 omega_max_rad_s: float = OMEGA_MAX_RAD_S, control_dt_s: float = 0.1,
+                 detection_range_m: float | None = None) -> None:
         from mjswarm.simulation import Simulation
         from mjswarm.world import Pose2D, world_spec
 
         super().__init__(positions, present, seed, position_noise_m, heading_noise_rad,
-                         omega_max_rad_s)
+                         omega_max_rad_s, control_dt_s, detection_range_m)
         self._depot = [(-floor_half_size_m + 0.4 * i, -floor_half_size_m - 1.0)
                        for i in range(self.n)]
         poses = [Pose2D(*(positions[i] if self.present[i] else self._depot[i]), 0.0)
@@ -154,6 +223,13 @@ class EmbodiedFloor(MotionWorld):
         self.present[i] = xy is not None
         where = xy if xy is not None else self._depot[i]
         self.sim.place_robot(i, self._pose_type(where[0], where[1], yaw))
+        self._sensed = self._detections = None
+        self.set_on_air(i, xy is not None)
+        self.relink()
+
+    @property
+    def contacts(self) -> int:
+        return self.sim.collisions.count
 
     def _advance(self, v, omega, duration_s) -> None:
         self.sim.set_velocity(v, omega)

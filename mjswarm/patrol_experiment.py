@@ -49,7 +49,9 @@ from algorithms.maintenance.roles import (
     RoleSwitchingRobot,
     Target,
 )
+from algorithms.robot import Command, Controller, Observation
 from mjswarm.errors import MjswarmError
+from mjswarm.loop import Loop, LoopFunctions
 from mjswarm.openfloor import EmbodiedFloor, MotionWorld, PointWorld
 from mjswarm.radio import Radio
 
@@ -114,16 +116,40 @@ def initial_positions(n: int, rng: np.random.Generator, params: RoleParams,
     raise MjswarmError(f"no connected deployment of {n} robots in {attempts} draws")
 
 
-def make_world(kind: str, positions: np.ndarray, seed: int) -> MotionWorld:
-    """The point world or the MuJoCo floor, sized for the target area."""
+def make_world(kind: str, positions: np.ndarray, seed: int, d_s: float) -> MotionWorld:
+    """The point world or the MuJoCo floor, sized for the target area, with a
+    range-and-bearing sensor of range ``d_s`` (m)."""
     omega = PAPER_TURN_CAP_RAD_PER_STEP / STEP_S  # the paper's 0.15 rad/step
+    points = [tuple(p) for p in positions]
     if kind == "point":
-        return PointWorld([tuple(p) for p in positions], seed=seed, omega_max_rad_s=omega)
+        return PointWorld(points, seed=seed, omega_max_rad_s=omega, control_dt_s=STEP_S,
+                          detection_range_m=d_s)
     if kind == "embodied":
         half = 1.8 * math.sqrt(len(positions)) + 4.0
-        return EmbodiedFloor([tuple(p) for p in positions], seed=seed, floor_half_size_m=half,
-                             omega_max_rad_s=omega)
+        return EmbodiedFloor(points, seed=seed, floor_half_size_m=half, omega_max_rad_s=omega,
+                             control_dt_s=STEP_S, detection_range_m=d_s)
     raise MjswarmError(f"unknown world {kind!r} (choose from {', '.join(WORLDS)})")
+
+
+class Timed(Controller):
+    """A controller measured: wall time of its steps (s), in total and by the role the
+    robot had when the step began (the paper's processing time, Fig. 8-9)."""
+
+    def __init__(self, inner: RoleSwitchingRobot) -> None:
+        self.inner = inner
+        self.seconds = 0.0
+        self.by_role: dict[str, list[float]] = {}
+
+    def step(self, observation: Observation) -> Command:
+        role = self.inner.role.value
+        t0 = time.perf_counter()
+        command = self.inner.step(observation)
+        elapsed = time.perf_counter() - t0
+        self.seconds += elapsed
+        spent = self.by_role.setdefault(role, [0.0, 0])
+        spent[0] += elapsed
+        spent[1] += 1
+        return command
 
 
 def network_graph(minds: list[RoleSwitchingRobot], xy: np.ndarray, d_c: float) -> nx.Graph:
@@ -149,6 +175,85 @@ def _runs(flags: list[bool]) -> list[int]:
     return runs + ([length] if length else [])
 
 
+class PatrolMission(LoopFunctions):
+    """The mission's loop functions: targets for the base station, and the measurements
+    of the module docstring (ground truth, never seen by the robots)."""
+
+    def __init__(self, robots: int, rng: np.random.Generator, params: RoleParams,
+                 minds: list[RoleSwitchingRobot], sample_every: int, keep_history: bool,
+                 progress: Callable[[int], None] | None) -> None:
+        self.robots, self.rng, self.params, self.minds = robots, rng, params, minds
+        self.sample_every, self.keep_history, self.progress = sample_every, keep_history, progress
+        self.side = 1.8 * math.sqrt(robots)
+        self.targets = 0
+        self.shadow = {"angle_tests": 0, "seconds": 0.0}
+        self.cut: list[bool] = []
+        self.leader_cut: list[bool] = []
+        self.lam: list[float] = []
+        self.lam_alg2: list[float] = []
+        self.lam_base: list[float] = []
+        self.history: dict[str, list] = {"positions": [], "roles": [], "edges": []}
+        self._flock_base = nx.Graph()
+        self._acted_from = np.zeros((robots, 2))  # true positions at the tick's start
+
+    def new_target(self, seq: int) -> Target:
+        """A target drawn in the target square (the simulator informs the base station)."""
+        return Target(seq, tuple(self.rng.uniform(0.0, self.side, 2)))
+
+    def initialize(self, loop: Loop) -> None:
+        for i, mind in enumerate(self.minds):
+            loop.world.show(i, mind.role)  # the experimenter assigns the initial roles
+
+    def before_step(self, loop: Loop) -> None:
+        """The every-step AAT baseline, run in the shadow on the robots each robot
+        detects (within d_s, showing a flock role)."""
+        t, truth = loop.ticks, loop.world.true_positions().copy()
+        self._acted_from = truth
+        self._flock_base = nx.Graph()
+        roles = loop.world.signals
+        for i in range(self.robots):
+            if roles[i] not in FLOCK:
+                continue
+            seen = np.flatnonzero(np.linalg.norm(truth - truth[i], axis=1) <= self.params.d_s)
+            candidates = {int(k): truth[k] for k in seen if k != i and roles[k] in FLOCK}
+            t0 = time.perf_counter()
+            base = refresh_connections(truth[i], (), candidates, range_m=self.params.d_c,
+                                       eta_c=self.params.eta_c, force_full=True)
+            self.shadow["seconds"] += time.perf_counter() - t0
+            self.shadow["angle_tests"] += base.angle_tests
+            if t % self.sample_every == 0:
+                self._flock_base.add_node(i)
+                self._flock_base.add_edges_from((i, k) for k in base.connections)
+
+    def after_step(self, loop: Loop) -> None:
+        """Network metrics on the positions the robots acted from, then the next target."""
+        t = loop.ticks - 1
+        truth = self._acted_from
+        minds = self.minds
+        g = network_graph(minds, truth, self.params.d_c)
+        reach = nx.node_connected_component(g, 0)
+        self.cut.append(len(reach) < self.robots)
+        leaders = [i for i, m in enumerate(minds) if m.role is Role.LOCAL_LEADER]
+        self.leader_cut.append(not leaders or leaders[0] not in reach)
+        if t % self.sample_every == 0:
+            self.lam.append(nx.algebraic_connectivity(g, method="tracemin_lu"))
+            flock = [i for i, m in enumerate(minds) if m.role in FLOCK]
+            for h, out_list in ((g.subgraph(flock), self.lam_alg2),
+                                (self._flock_base, self.lam_base)):
+                out_list.append(nx.algebraic_connectivity(h, method="tracemin_lu")
+                                if h.number_of_nodes() > 1 else 0.0)
+            if self.keep_history:
+                self.history["positions"].append(truth.tolist())
+                self.history["roles"].append([m.role.value for m in minds])
+                self.history["edges"].append(sorted(g.edges()))
+        base_station = minds[0]
+        if base_station.target is not None and base_station.arrived >= base_station.target.seq:
+            self.targets += 1
+            base_station.target = self.new_target(base_station.target.seq + 1)
+        if self.progress is not None:
+            self.progress(1)
+
+
 def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
               params: RoleParams | None = None, every_step_aat: bool = False,
               sample_every: int = 10, progress: Callable[[int], None] | None = None,
@@ -163,101 +268,49 @@ def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
     rng = np.random.default_rng(seed)
     xy0 = initial_positions(robots, rng, params)
     leader = 1 + int(np.argmin(np.linalg.norm(xy0[1:], axis=1)))
-    minds = [RoleSwitchingRobot(i, Role.EXPLORER, params, every_step_aat=every_step_aat)
-             for i in range(robots)]
-    minds[0] = RoleSwitchingRobot(0, Role.BASE_STATION, params, child=leader)
+    minds = [RoleSwitchingRobot(i, Role.EXPLORER, params, every_step_aat=every_step_aat,
+                                step_s=STEP_S) for i in range(robots)]
+    minds[0] = RoleSwitchingRobot(0, Role.BASE_STATION, params, child=leader, step_s=STEP_S)
     minds[leader] = RoleSwitchingRobot(leader, Role.LOCAL_LEADER, params, parent=0,
-                                       every_step_aat=every_step_aat)
+                                       every_step_aat=every_step_aat, step_s=STEP_S)
     minds[0].connections, minds[leader].connections = {leader}, {0}
-    side = 1.8 * math.sqrt(robots)
-    minds[0].target = Target(0, tuple(rng.uniform(0.0, side, 2)))
-    floor = make_world(world, xy0, seed)
-    radio = Radio(range(robots), range_m=params.d_c, rng=seed)
-    cpu = np.zeros(robots)
-    cpu_by_role: dict[str, list[float]] = {r.value: [0.0, 0] for r in Role}
-    shadow = {"angle_tests": 0, "seconds": 0.0}
-    targets = 0
-    cut, leader_cut, lam, lam_alg2, lam_base = [], [], [], [], []
-    history: dict[str, list] = {"positions": [], "roles": [], "edges": []}
-    for t in range(steps):
-        truth = floor.true_positions()
-        radio.step({i: truth[i] for i in range(robots)})
-        sensed = floor.sense()[:, :2]
-        roles = [m.role for m in minds]
-        dist = np.linalg.norm(sensed[:, None, :] - sensed[None, :, :], axis=-1)
-        velocities = np.zeros((robots, 2))
-        flock_base = nx.Graph()
-        for i, mind in enumerate(minds):
-            seen = np.flatnonzero((dist[i] <= params.d_s) & (np.arange(robots) != i))
-            detected = {int(k): Detected(sensed[k], roles[k]) for k in seen}
-            inbox = [(msg.sender, msg.payload) for msg in radio.receive(i)]
-            t0 = time.perf_counter()
-            u, out = mind.tick(t, sensed[i], detected, inbox)
-            elapsed = time.perf_counter() - t0
-            cpu[i] += elapsed
-            cpu_by_role[mind.role.value][0] += elapsed
-            cpu_by_role[mind.role.value][1] += 1
-            for to, payload in out:
-                radio.send(i, payload, to=to)
-            velocities[i] = u / STEP_S
-            if roles[i] in FLOCK:
-                candidates = {k: d.x for k, d in detected.items() if d.role in FLOCK}
-                t0 = time.perf_counter()
-                base = refresh_connections(sensed[i], (), candidates, range_m=params.d_c,
-                                           eta_c=params.eta_c, force_full=True)
-                shadow["seconds"] += time.perf_counter() - t0
-                shadow["angle_tests"] += base.angle_tests
-                if t % sample_every == 0:
-                    flock_base.add_node(i)
-                    flock_base.add_edges_from((i, k) for k in base.connections)
-        g = network_graph(minds, truth, params.d_c)
-        reach = nx.node_connected_component(g, 0)
-        cut.append(len(reach) < robots)
-        leaders = [i for i, m in enumerate(minds) if m.role is Role.LOCAL_LEADER]
-        leader_cut.append(not leaders or leaders[0] not in reach)
-        if t % sample_every == 0:
-            lam.append(nx.algebraic_connectivity(g, method="tracemin_lu"))
-            flock = [i for i, m in enumerate(minds) if m.role in FLOCK]
-            flock_alg2 = g.subgraph(flock)
-            for h, out_list in ((flock_alg2, lam_alg2), (flock_base, lam_base)):
-                out_list.append(nx.algebraic_connectivity(h, method="tracemin_lu")
-                                if h.number_of_nodes() > 1 else 0.0)
-            if keep_history:
-                history["positions"].append(truth.tolist())
-                history["roles"].append([m.role.value for m in minds])
-                history["edges"].append(sorted(g.edges()))
-        base_station = minds[0]
-        if base_station.target is not None and base_station.arrived >= base_station.target.seq:
-            targets += 1
-            base_station.target = Target(base_station.target.seq + 1,
-                                         tuple(rng.uniform(0.0, side, 2)))
-        floor.step(velocities, STEP_S)
-        if progress is not None:
-            progress(1)
+    mission = PatrolMission(robots, rng, params, minds, sample_every, keep_history, progress)
+    minds[0].target = mission.new_target(0)
+    floor = make_world(world, xy0, seed, params.d_s)
+    floor.attach_radio(Radio(range(robots), range_m=params.d_c, rng=seed))
+    timed = [Timed(m) for m in minds]
+    loop = Loop(floor, dict(enumerate(timed)), [mission])
+    loop.run(max_ticks=steps)
     robot_steps = robots * steps
+    cpu_by_role: dict[str, list[float]] = {r.value: [0.0, 0] for r in Role}
+    for t in timed:
+        for role, (seconds, calls) in t.by_role.items():
+            cpu_by_role[role][0] += seconds
+            cpu_by_role[role][1] += calls
     angle_alg2 = sum(m.angle_tests for m in minds)
     circle_alg2 = sum(m.circle_tests for m in minds)
+    shadow, runs = mission.shadow, _runs
     return TrialResult(
         robots=robots, steps=steps, seed=seed, world=world,
-        disconnections=len(_runs(cut)), recovery_steps=_runs(cut),
-        leader_gaps=_runs(leader_cut), targets_reached=targets,
+        disconnections=len(runs(mission.cut)), recovery_steps=runs(mission.cut),
+        leader_gaps=runs(mission.leader_cut), targets_reached=mission.targets,
         repeaters_final=sum(m.role is Role.REPEATER for m in minds),
-        processing_s_per_robot_step=float(cpu.sum() / robot_steps),
+        processing_s_per_robot_step=float(sum(t.seconds for t in timed) / robot_steps),
         processing_s_per_robot_step_by_role={
             r: (s / k if k else None) for r, (s, k) in cpu_by_role.items()},
-        messages_per_robot_step=sum(radio.received.values()) / robot_steps,
-        algebraic_connectivity=float(np.mean(lam)),
+        messages_per_robot_step=sum(floor.radio.received.values()) / robot_steps,
+        algebraic_connectivity=float(np.mean(mission.lam)),
         aat_robots={"angle_tests_per_robot_step": angle_alg2 / robot_steps,
-                  "circle_tests_per_robot_step": circle_alg2 / robot_steps,
-                  "tests_per_robot_step": (angle_alg2 + circle_alg2) / robot_steps,
-                  "seconds_per_robot_step": sum(m.aat_seconds for m in minds) / robot_steps,
-                  "algebraic_connectivity": float(np.mean(lam_alg2))},
+                    "circle_tests_per_robot_step": circle_alg2 / robot_steps,
+                    "tests_per_robot_step": (angle_alg2 + circle_alg2) / robot_steps,
+                    "seconds_per_robot_step": sum(m.aat_seconds for m in minds) / robot_steps,
+                    "algebraic_connectivity": float(np.mean(mission.lam_alg2))},
         aat_every_step={"angle_tests_per_robot_step": shadow["angle_tests"] / robot_steps,
                         "seconds_per_robot_step": shadow["seconds"] / robot_steps,
-                        "algebraic_connectivity": float(np.mean(lam_base))},
-        collisions=(floor.sim.collisions.count if isinstance(floor, EmbodiedFloor) else None),
+                        "algebraic_connectivity": float(np.mean(mission.lam_base))},
+        collisions=floor.contacts,
         wall_s=time.perf_counter() - started,
-        history=history if keep_history else {},
+        history=mission.history if keep_history else {},
     )
 
 

@@ -44,12 +44,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
-from typing import Any, NamedTuple
+from typing import Any
 
 import networkx as nx
 import numpy as np
 from scipy.spatial import cKDTree
 
+from algorithms.robot import Message
 from mjswarm.errors import MjswarmError
 
 #: ``blocked(pairs) -> mask``: for an (M, 2) array of robot-id pairs ``(i, j)`` (int64 when
@@ -59,13 +60,6 @@ Blocker = Callable[[np.ndarray], np.ndarray]
 
 #: relative enlargement of the k-d tree's search radius over d_c (the exact test decides)
 _CANDIDATE_SLACK = 1e-9
-
-
-class Message(NamedTuple):
-    """One received copy: who sent it and what it carries (opaque to the radio)."""
-
-    sender: Hashable
-    payload: Any
 
 
 class Radio:
@@ -118,7 +112,7 @@ class Radio:
         self._ordered: dict[Hashable, tuple] = {r: () for r in self.robots}
         self._edges: frozenset[frozenset] | None = None
         self._positions: dict[Hashable, np.ndarray] = {}
-        self._outbox: list[tuple[Hashable, Any, tuple[Hashable, ...]]] = []
+        self._outbox: list[tuple[Message, tuple[Hashable, ...]]] = []
         self._inbox: dict[Hashable, list[Message]] = {r: [] for r in self.robots}
         #: transmissions per robot (one per :meth:`send`)
         self.sent: dict[Hashable, int] = dict.fromkeys(self.robots, 0)
@@ -130,6 +124,8 @@ class Radio:
         self.blackout = False
         #: number of :meth:`step` calls so far
         self.tick = 0
+        #: transmissions the last :meth:`step` delivered (those sent in the tick before it)
+        self.last_batch = 0
         if edges is not None:
             self.set_edges(edges)
 
@@ -150,9 +146,16 @@ class Radio:
     def remove(self, robot: Hashable) -> None:
         """The robot leaves (crash or recall): no links, nothing more sent to or by it."""
         self._present.pop(robot, None)
-        self._outbox = [m for m in self._outbox if m[0] != robot]
+        self._outbox = [m for m in self._outbox if m[0].sender != robot]
         self._inbox[robot].clear()
         self._relink()
+
+    def restore(self, robot: Hashable) -> None:
+        """A removed robot is back on the air (an empty inbox; links at the next relink)."""
+        if robot not in self._inbox:
+            raise MjswarmError(f"radio: robot {robot!r} is not one of this radio's robots")
+        if robot not in self._present:
+            self._present = {r: None for r in self.robots if r in self._present or r == robot}
 
     def neighbors(self, robot: Hashable) -> frozenset:
         """Robots that hear ``robot`` this tick (link-layer knowledge, no message cost)."""
@@ -204,7 +207,7 @@ class Radio:
             recipients = self._ordered[sender]
         else:
             recipients = (to,) if to in self._neighbors[sender] else ()
-        self._outbox.append((sender, payload, recipients))
+        self._outbox.append((Message(payload, to, sender), recipients))
 
     def receive(self, robot: Hashable) -> list[Message]:
         """Drain and return what ``robot`` has received (in delivery order)."""
@@ -224,8 +227,8 @@ class Radio:
     # -- internals ----------------------------------------------------------------------
     def _deliver(self) -> None:
         outbox, self._outbox = self._outbox, []
-        for sender, payload, recipients in outbox:
-            message = Message(sender, payload)
+        self.last_batch = len(outbox)
+        for message, recipients in outbox:
             for r in recipients:
                 if r not in self._present:
                     continue
@@ -278,6 +281,53 @@ class Radio:
             r: tuple(names[bounds[k] : bounds[k + 1]]) for k, r in enumerate(self.robots)
         }
         self._neighbors = {r: frozenset(t) for r, t in self._ordered.items()}
+
+
+class Uplink:
+    """The link between the robots and one piece of infrastructure at ``address`` (the
+    vertex stations: seed 003's central station over XBee): every robot reaches it from
+    anywhere, one control tick each way, no drops; counted both ways.
+
+    Robots send with ``Message(payload, to=address)``; the world hands those to
+    :meth:`send` and, at the end of each tick, calls :meth:`step`; the station reads
+    :meth:`receive` and answers with :meth:`reply`, which the robot reads a tick later.
+    """
+
+    def __init__(self, address: Hashable) -> None:
+        self.address = address
+        self._up: list[Message] = []
+        self._down: list[Message] = []
+        self._station_inbox: list[Message] = []
+        self._robot_inbox: dict[Hashable, list[Message]] = {}
+        #: messages from robots, and replies to robots
+        self.sent_up = 0
+        self.sent_down = 0
+
+    def send(self, robot: Hashable, payload: Any) -> None:
+        """A robot's message to the station."""
+        self._up.append(Message(payload, self.address, robot))
+        self.sent_up += 1
+
+    def reply(self, robot: Hashable, payload: Any) -> None:
+        """The station's message to one robot."""
+        self._down.append(Message(payload, robot, self.address))
+        self.sent_down += 1
+
+    def step(self) -> None:
+        """End of a tick: deliver what was sent in it."""
+        self._station_inbox += self._up
+        for m in self._down:
+            self._robot_inbox.setdefault(m.to, []).append(m)
+        self._up, self._down = [], []
+
+    def receive(self) -> list[Message]:
+        """Drain the station's inbox."""
+        inbox, self._station_inbox = self._station_inbox, []
+        return inbox
+
+    def receive_for(self, robot: Hashable) -> list[Message]:
+        """Drain one robot's replies."""
+        return self._robot_inbox.pop(robot, [])
 
 
 def walls_blocker(

@@ -273,10 +273,10 @@ class Simulation:
             self.state_version += 1
             self.battery.update(d.actuator_force[self._actuators], self.control_dt_s)
             self.collisions.update(d)
-            previous = self._readings["encoder"] - self._slip_rad
+            previous = self._readings["encoder"] if self.wheel_slip else None
             self._readings = self._read_sensors()
             if self.wheel_slip:
-                turned = self._readings["encoder"] - self._slip_rad - previous
+                turned = self._readings["encoder"] - previous
                 slip = np.abs(self.rng.normal(0.0, self.wheel_slip, turned.shape)) * turned
                 self._slip_rad += slip
                 self._readings["encoder"] += slip

@@ -6,6 +6,7 @@ from __future__ import annotations
 import rerun as rr
 
 from mjswarm.arena import load_arena
+from mjswarm.awareness import truth
 from mjswarm.cli import main
 from mjswarm.embodied import EmbodiedConfig, EmbodiedExploration
 from mjswarm.graphworld import make_minds
@@ -18,16 +19,19 @@ def test_tables_follow_the_moving_radio_graph():
     while run.declared is None and run.sim.time_s < 1200:
         run.step()
         if run.sim.step_count % 10 == 0:
-            seen.update(run.awareness.truth().values())
+            seen.update(truth(run.world.radio.graph(), 0, range(1, 4)).values())
     result = run.result()
     assert result.completed
     assert seen == {"biconnected", "not"}  # the truth changed while they moved
     assert result.radio_belief_agreement > 0.98  # beliefs lag the truth by a few ticks
-    aware = run.awareness
-    for _ in range(100):  # robots stand still: once the radio is quiet, tables are exact
-        aware.step(run.active)
-    assert aware.radio.pending == 0
-    assert aware.beliefs() == aware.truth()
+    for robot in run.robots:  # robots stand still (their tables keep ticking) ...
+        robot.declared = True
+    for _ in range(100):
+        run.step()
+    assert run.world.radio.last_batch == 0  # ... and once the radio is quiet, tables are exact
+    beliefs = {i: "biconnected" if run.robots[i].table.is_doubly_connected() else "not"
+               for i in range(1, 4)}
+    assert beliefs == truth(run.world.radio.graph(), 0, range(1, 4))
 
 
 def test_recording_shows_radio_graph_and_beliefs(tmp_path, capsys):

@@ -11,6 +11,7 @@ import pytest
 
 from mjswarm.cli import main
 from mjswarm.coverage_experiment import CLEARANCE_M, CoverageRun
+from mjswarm.loop import LoopFunctions
 
 
 def truth_graph(run: CoverageRun) -> nx.Graph:
@@ -70,16 +71,15 @@ def test_bodies_keep_their_distance_and_see_the_same_episodes(cr, placement, see
     points = CoverageRun(cr, placement, "point", seed)
     bodies = CoverageRun(cr, placement, "point", seed, clearance_m=CLEARANCE_M)
     closest = [math.inf]
-    step = bodies.world.step
 
-    def watched_step(velocities, duration_s):
-        step(velocities, duration_s)
-        pos = bodies.world.true_positions()
-        ids = [i for i in range(bodies.world.n) if bodies.world.present[i]]
-        closest[0] = min([closest[0], *(math.dist(pos[a], pos[b])
-                                         for a in ids for b in ids if a < b)])
+    class Watcher(LoopFunctions):
+        def after_step(self, loop):
+            pos = loop.world.true_positions()
+            ids = loop.world.active()
+            closest[0] = min([closest[0], *(math.dist(pos[a], pos[b])
+                                             for a in ids for b in ids if a < b)])
 
-    bodies.world.step = watched_step
+    bodies.loop.functions.append(Watcher())
     for _ in range(60):
         a, b = points.step_episode(), bodies.step_episode()
         assert (a.action, a.robot, a.robots) == (b.action, b.robot, b.robots)

@@ -17,7 +17,8 @@ from algorithms.connectivity import ConnectivityTable, TableCheck, merge_groups
 from algorithms.connectivity.tables import LinkBroken, NewAccessPath, crossed_before
 from mjswarm.connectivity import Team, drive, run_check
 from mjswarm.connectivity.comparison import geometric_range, random_team, ring_team
-from mjswarm.radio import Message, Radio
+from algorithms.robot import Message
+from mjswarm.radio import Radio
 
 # -- helpers --------------------------------------------------------------------------
 
@@ -26,13 +27,13 @@ def build(graph, reference, *, max_forwards=None, radio=None):
     """Run Algorithm 1 over ``graph``'s links until no message is in flight."""
     radio = radio or Radio(list(graph), edges=list(graph.edges))
     tables = {r: ConnectivityTable(r, reference, max_forwards=max_forwards) for r in graph}
-    tick, _ = drive(radio, tables, lambda: radio.pending == 0)
+    tick, _ = drive(radio, tables, lambda: radio.last_batch == 0)
     return radio, tables, tick
 
 
 def settle(radio, tables, start):
     """Keep running after a topology change until quiet again."""
-    tick, _ = drive(radio, tables, lambda: radio.pending == 0, start=start)
+    tick, _ = drive(radio, tables, lambda: radio.last_batch == 0, start=start)
     return tick
 
 
@@ -198,7 +199,7 @@ def test_forwarding_rule_stops_after_two_disjoint_paths():
     neighbours = {"a", "b", "c"}
     out = table.tick(0, [], neighbours)
     def heard(sender, *path):
-        return [Message(sender, NewAccessPath(path, (0,) * len(path)))]
+        return [Message(NewAccessPath(path, (0,) * len(path)), sender=sender)]
 
     out += table.tick(1, heard("a", "x", "ref"), neighbours)
     out += table.tick(2, heard("a", "w", "x", "ref"), neighbours)  # does not shrink {a, x}
@@ -211,8 +212,8 @@ def test_forwarding_rule_stops_after_two_disjoint_paths():
 def test_paths_from_a_robot_that_is_not_a_neighbour_are_ignored():
     table = ConnectivityTable("r", "ref")
     table.tick(0, [], {"a"})
-    table.tick(1, [Message("b", NewAccessPath(("ref",), (0,)))], {"a"})
-    table.tick(2, [Message("a", NewAccessPath(("r", "ref"), (1, 0)))], {"a"})  # a loop
+    table.tick(1, [Message(sender="b", payload=NewAccessPath(("ref",), (0,)))], {"a"})
+    table.tick(2, [Message(sender="a", payload=NewAccessPath(("r", "ref"), (1, 0)))], {"a"})  # a loop
     assert table.paths == [] and not table.has_access_path()
 
 
@@ -224,22 +225,22 @@ def test_link_broken_deletes_only_paths_that_crossed_the_link_before_it_broke():
     assert not crossed_before("r", route, (9, 8, 3), LinkBroken("b", "a", 4))  # crossed later
     table = ConnectivityTable("r", "ref")
     table.tick(0, [], {"a", "c"})
-    table.tick(3, [Message("a", NewAccessPath(("b", "ref"), (2, 1))),
-                   Message("c", NewAccessPath(("d", "ref"), (2, 1)))], {"a", "c"})
-    out = table.tick(4, [Message("c", LinkBroken("b", "ref", 2))], {"a", "c"})
+    table.tick(3, [Message(sender="a", payload=NewAccessPath(("b", "ref"), (2, 1))),
+                   Message(sender="c", payload=NewAccessPath(("d", "ref"), (2, 1)))], {"a", "c"})
+    out = table.tick(4, [Message(sender="c", payload=LinkBroken("b", "ref", 2))], {"a", "c"})
     assert table.paths == [("c", "d", "ref")]
     assert [o.payload for o in out] == [LinkBroken("b", "ref", 2)]  # deleted, so forwarded
-    assert table.tick(5, [Message("c", LinkBroken("b", "ref", 2))], {"a", "c"}) == []
+    assert table.tick(5, [Message(sender="c", payload=LinkBroken("b", "ref", 2))], {"a", "c"}) == []
 
 
 def test_a_stale_link_broken_spares_paths_learnt_over_the_link_as_it_is_now():
     table = ConnectivityTable("r", "ref")
     table.tick(0, [], {"a"})
-    table.tick(1, [Message("a", NewAccessPath(("b", "ref"), (0, 0)))], {"a"})
+    table.tick(1, [Message(sender="a", payload=NewAccessPath(("b", "ref"), (0, 0)))], {"a"})
     # a-b broke at tick 2 and came back; the path is heard again over the new link
-    out = table.tick(6, [Message("a", NewAccessPath(("b", "ref"), (5, 4)))], {"a"})
+    out = table.tick(6, [Message(sender="a", payload=NewAccessPath(("b", "ref"), (5, 4)))], {"a"})
     assert [o.payload for o in out] == [NewAccessPath(("a", "b", "ref"), (6, 5, 4))]
-    assert table.tick(7, [Message("a", LinkBroken("a", "b", 2))], {"a"}) == []
+    assert table.tick(7, [Message(sender="a", payload=LinkBroken("a", "b", 2))], {"a"}) == []
     assert table.paths == [("a", "b", "ref")]
 
 

@@ -7,9 +7,10 @@ import json
 import pytest
 
 from mjswarm.arena import load_arena
-from mjswarm.embodied import EmbodiedConfig, explore_embodied
+from mjswarm.embodied import EmbodiedConfig, EmbodiedExploration, explore_embodied
 from mjswarm.errors import MjswarmError
 from mjswarm.faults import BeaconWipe, RadioBlackout, RobotFailure, parse_fault
+from mjswarm.graphworld import make_minds
 from mjswarm.radio import Radio
 
 
@@ -96,6 +97,11 @@ def test_a_wiped_beacon_is_reported():
     if result.completed:
         assert result.map_correct == (sorted(result.map_edges) == sorted(
             tuple(sorted(e)) for e in load_arena("arena1").edges))
+    # what it makes of it here: R1 drops a second beacon at v1 and later finds no route
+    # between its two names for v1; it stops, says why, and the run ends at once
+    assert not result.completed and result.ended_because == "all robots stopped"
+    [stopped] = result.stopped_robots
+    assert stopped["robot"] == 1 and "its strategy failed" in stopped["reason"]
 
 
 def test_radio_blackout_drops_table_messages():
@@ -107,6 +113,29 @@ def test_radio_blackout_drops_table_messages():
     assert [f["fault"] for f in b.faults] == ["radio-blackout@5-40", "radio back at 40"]
     assert a.paths == b.paths  # exploration does not use the radio
     assert b.radio_belief_agreement < a.radio_belief_agreement or b.radio_messages != a.radio_messages
+
+
+def test_radio_blackout_silences_the_radio_for_its_interval_only():
+    """The radio drops every copy from T1 to T2 and none outside it."""
+    def run(faults):
+        config = EmbodiedConfig(speed_m_s=0.1, radio_range_m=1.5, max_sim_time_s=60,
+                                faults=faults)
+        exploration = EmbodiedExploration(load_arena("arena1"),
+                                          make_minds("incidence-dfs", 2, 0), config, 0)
+        radio, blackout = exploration.world.radio, {}
+        while exploration.sim.time_s < 60.0:
+            exploration.step()
+            blackout[round(exploration.sim.time_s, 2)] = radio.blackout
+        return radio, blackout
+
+    quiet, never = run([])
+    dark, flags = run([parse_fault("radio-blackout@5-40")])
+    assert quiet.dropped == 0 and not any(never.values())
+    assert dark.dropped > 0
+    # on from the tick that starts at 5 s to the one that starts at 40 s (flags are read
+    # after each tick's step, 20 ms later)
+    assert [t for t, on in flags.items() if on] == pytest.approx(
+        [round(0.02 * k, 2) for k in range(251, 2001)], abs=1e-9)
 
 
 def test_cli_reports_faults_and_stopped_robots(capsys):

@@ -8,12 +8,15 @@ import math
 import numpy as np
 import pytest
 
-from algorithms.navigation import NavigatorState
+from algorithms.navigation import Navigator, NavigatorState
+from algorithms.navigation.driving import Navigating
 from algorithms.navigation.navigator import frame_offset
 from mjswarm.arena import incidence_angle, load_arena
 from mjswarm.arena.builder import arena_world_spec
-from mjswarm.navigation import NavigationDriver
+from mjswarm.loop import Loop
+from mjswarm.navigation import calibration, conventions
 from mjswarm.simulation import Simulation
+from mjswarm.sparkworld import SparkWorld
 from mjswarm.world import Pose2D
 
 
@@ -49,8 +52,8 @@ def test_scans_in_either_direction_measure_the_true_angles(direction):
     spec = load_arena("fig9")
     x, y = spec.vertices["v4"]
     sim = Simulation(arena_world_spec(spec, [Pose2D(x, y, 0.3)]))
-    driver = NavigationDriver(sim, headings=[0.3], speed_m_s=0.1)
-    nav = driver.navigators[0]
+    nav = Navigator(calibration(sim.geometry), conventions(sim.geometry), 0.3, 0.1)
+    driver = Loop(SparkWorld(sim), {0: Navigating(nav)})
     for scan in range(2 if direction == -1 else 1):
         nav.begin_at_vertex()
         while nav.state is not NavigatorState.AT_VERTEX:

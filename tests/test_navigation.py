@@ -16,11 +16,14 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from algorithms.navigation import NavigatorState
+from algorithms.navigation import Navigator, NavigatorState
+from algorithms.navigation.driving import Navigating
 from mjswarm.arena import incidence_angle, lane_strips, load_arena
 from mjswarm.arena.builder import arena_world_spec
-from mjswarm.navigation import NavigationDriver
+from mjswarm.loop import Loop
+from mjswarm.navigation import calibration, conventions
 from mjswarm.simulation import Simulation
+from mjswarm.sparkworld import SparkWorld
 from mjswarm.world import Pose2D
 
 SPEED_M_S = 0.1
@@ -41,8 +44,8 @@ def run_walk(name: str, legs: int | None = None) -> dict:
     walk = walk[: legs + 1] if legs else walk
     x, y = spec.vertices[spec.root]
     sim = Simulation(arena_world_spec(spec, [Pose2D(x, y, 0.0)]))
-    driver = NavigationDriver(sim, headings=[0.0], speed_m_s=SPEED_M_S)
-    nav = driver.navigators[0]
+    nav = Navigator(calibration(sim.geometry), conventions(sim.geometry), 0.0, SPEED_M_S)
+    driver = Loop(SparkWorld(sim), {0: Navigating(nav)})
     nav.begin_at_vertex()
     record = {"angle_errors": [], "arrival_errors": [], "edge_times": [], "spec": spec}
 
@@ -101,8 +104,8 @@ def test_measured_angles_are_in_the_robots_own_frame():
     spec = load_arena("fig9")
     x, y = spec.vertices[spec.root]
     sim = Simulation(arena_world_spec(spec, [Pose2D(x, y, 0.0)]))
-    driver = NavigationDriver(sim, headings=[math.pi / 2], speed_m_s=SPEED_M_S)
-    nav = driver.navigators[0]
+    nav = Navigator(calibration(sim.geometry), conventions(sim.geometry), math.pi / 2, SPEED_M_S)
+    driver = Loop(SparkWorld(sim), {0: Navigating(nav)})
     nav.begin_at_vertex()
     while nav.state is not NavigatorState.AT_VERTEX:
         driver.step()

@@ -9,7 +9,9 @@ import numpy as np
 import pytest
 
 from algorithms.motion import track_velocity
+from algorithms.robot import Command, Controller, Observation
 from mjswarm.errors import MjswarmError
+from mjswarm.loop import Loop
 from mjswarm.openfloor import EmbodiedFloor, PointWorld, spread
 
 
@@ -21,17 +23,33 @@ def test_track_velocity_turns_first_and_never_reverses():
     assert v == pytest.approx(0.0, abs=1e-12) and w == 2.0
 
 
+class GoTo(Controller):
+    """Heads for ``goal`` (m) at up to 0.1 m/s from its own positioning sensor."""
+
+    def __init__(self, goal) -> None:
+        self.goal = np.asarray(goal, float)
+
+    def step(self, observation: Observation) -> Command:
+        delta = self.goal - observation.pose[:2]
+        return Command(velocity_m_s=tuple(delta / max(1.0, np.linalg.norm(delta) / 0.1)))
+
+
+class Fixed(Controller):
+    """Commands the planar velocity ``velocity(tick)`` (m/s)."""
+
+    def __init__(self, velocity) -> None:
+        self.velocity, self.tick = velocity, 0
+
+    def step(self, observation: Observation) -> Command:
+        self.tick += 1
+        return Command(velocity_m_s=self.velocity(self.tick - 1))
+
+
 @pytest.mark.parametrize("world", [PointWorld, EmbodiedFloor])
 def test_worlds_reach_a_goal_by_velocity_commands(world):
     w = world([(0.0, 0.0), (1.0, 1.0)])
-    goal = np.array([0.6, -0.4])
-    for _ in range(200):
-        sensed = w.sense()
-        command = np.zeros((2, 2))
-        delta = goal - sensed[0, :2]
-        command[0] = delta / max(1.0, np.linalg.norm(delta) / 0.1)
-        w.step(command, 0.1)
-    assert np.linalg.norm(w.true_positions()[0] - goal) < 0.03
+    Loop(w, {0: GoTo((0.6, -0.4)), 1: Fixed(lambda t: (0.0, 0.0))}).run(max_ticks=200)
+    assert np.linalg.norm(w.true_positions()[0] - (0.6, -0.4)) < 0.03
     assert np.linalg.norm(w.true_positions()[1] - (1.0, 1.0)) < 1e-3  # idle robot stays
 
 
@@ -40,9 +58,8 @@ def test_embodied_and_point_trajectories_agree():
     ends = []
     for world in (PointWorld, EmbodiedFloor):
         w = world([(0.0, 0.0)])
-        for k in range(100):
-            angle = 0.02 * k
-            w.step(np.array([[0.1 * math.cos(angle), 0.1 * math.sin(angle)]]), 0.1)
+        arc = Fixed(lambda k: (0.1 * math.cos(0.02 * k), 0.1 * math.sin(0.02 * k)))
+        Loop(w, {0: arc}).run(max_ticks=100)
         ends.append(w.true_positions()[0].copy())
     assert np.linalg.norm(ends[0] - ends[1]) < 0.05
 
@@ -50,11 +67,13 @@ def test_embodied_and_point_trajectories_agree():
 def test_add_and_remove_robots():
     w = EmbodiedFloor([(0.0, 0.0), (0.5, 0.0)], present=[True, False])
     assert not w.present[1] and w.true_positions()[1, 1] < -10
+    loop = Loop(w, {0: Fixed(lambda t: (0.0, 0.0)), 1: Fixed(lambda t: (0.0, 0.0))})
+    assert w.active() == [0]
     w.place(1, (0.5, 0.5))
-    w.step(np.zeros((2, 2)), 0.2)
+    loop.run(max_ticks=2)
     assert w.present[1] and np.linalg.norm(w.true_positions()[1] - (0.5, 0.5)) < 0.01
     w.place(0, None)
-    assert not w.present[0]
+    assert not w.present[0] and w.active() == [1]
 
 
 def test_spread_and_bad_parameters():

@@ -6,11 +6,14 @@
   reference robot (Algorithm 1, New-Access-Path), Link-Broken updates, table exchange
   with new neighbours, the forward-two variant, and the check the tables give.
 
-Every robot object has ``tick(now, inbox, neighbors) -> list[Outgoing]`` (see
-:mod:`.base`); the static harness and the embodied world drive it the same way.
+Every robot object has ``tick(now, inbox, neighbors) -> list[Message]``, driven once per
+control tick (one tick is the papers' bound c on a one-hop relay, seed 002 Assumption 4;
+"a step" in seed 004): ``now`` is the tick number, ``inbox`` what the radio delivered this
+tick (:class:`algorithms.robot.Message` with its sender), ``neighbors`` the ids the robot
+hears this tick (both papers take neighbour discovery from the network layer; it costs no
+messages). The controllers of :mod:`algorithms.controllers` wrap them.
 """
 
-from algorithms.connectivity.base import Outgoing, Received
 from algorithms.connectivity.stamps import BiconnectivityCheck, dcr_members, stamp_relay
 from algorithms.connectivity.tables import (
     ConnectivityTable,
@@ -22,8 +25,6 @@ from algorithms.connectivity.tables import (
 __all__ = [
     "BiconnectivityCheck",
     "ConnectivityTable",
-    "Outgoing",
-    "Received",
     "Report",
     "TableCheck",
     "dcr_members",

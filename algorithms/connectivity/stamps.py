@@ -44,7 +44,7 @@ from __future__ import annotations
 from collections.abc import Hashable, Iterable
 from typing import NamedTuple
 
-from algorithms.connectivity.base import Outgoing, Received
+from algorithms.robot import Message
 
 CR = "CR"
 DCR = "DCR"
@@ -140,10 +140,10 @@ class BiconnectivityCheck:
         return None if self.result is None else self.result and bool(self.connected)
 
     def tick(
-        self, now: int, inbox: Iterable[Received], neighbors: Iterable[Hashable] = ()
-    ) -> list[Outgoing]:
+        self, now: int, inbox: Iterable[Message], neighbors: Iterable[Hashable] = ()
+    ) -> list[Message]:
         """Process this tick's messages and answer with the messages to broadcast."""
-        out: list[Outgoing] = []
+        out: list[Message] = []
         if self.initiator and self.started_at is None:
             self._start_check(now, out)
         for message in inbox:
@@ -160,21 +160,21 @@ class BiconnectivityCheck:
             self._algorithm3(now, out)
         return out
 
-    def _cr_fill(self, out: list[Outgoing]) -> None:
+    def _cr_fill(self, out: list[Message]) -> None:
         """CR-FILL: originate this robot's CR message, once per check."""
         if not self._cr_filled:
             self._cr_filled = True
-            out.append(Outgoing(Stamped(CR, (self.robot_id,))))
+            out.append(Message(Stamped(CR, (self.robot_id,))))
 
-    def _start_check(self, now: int, out: list[Outgoing]) -> None:
+    def _start_check(self, now: int, out: list[Message]) -> None:
         """Algorithm 3 line 1: run CR-FILL and DCR-FILL (Algorithm 2 line 1)."""
         if self.started_at is not None:
             return
         self.started_at = now
         self._cr_fill(out)
-        out.append(Outgoing(Stamped(DCR, (self.robot_id,))))  # DCR-FILL
+        out.append(Message(Stamped(DCR, (self.robot_id,))))  # DCR-FILL
 
-    def _on_stamped(self, message: Stamped, out: list[Outgoing]) -> None:
+    def _on_stamped(self, message: Stamped, out: list[Message]) -> None:
         """Fill CR_R (CR-FILL) or DCR_R (Algorithm 2 lines 6-8), then relay (Algorithm 1)."""
         self._cr_fill(out)
         if message.kind == CR:
@@ -184,16 +184,16 @@ class BiconnectivityCheck:
             self.dcr.update(dcr_members(message.stamps, self.robot_id))
         relayed = stamp_relay(message.stamps, self.robot_id)
         if relayed is not None:
-            out.append(Outgoing(Stamped(message.kind, relayed)))
+            out.append(Message(Stamped(message.kind, relayed)))
 
-    def _algorithm3(self, now: int, out: list[Outgoing]) -> None:
+    def _algorithm3(self, now: int, out: list[Message]) -> None:
         """Algorithm 3 lines 2-11, once this robot's 3Nc wait is over."""
         assert self.started_at is not None
         if self._doubly_connected_to_all is None and now >= self.started_at + self.wait:
             if self.initiator:
-                out.append(Outgoing(Control(CHECK_REQUEST)))  # line 2
+                out.append(Message(Control(CHECK_REQUEST)))  # line 2
             self._doubly_connected_to_all = len(self.dcr) == len(self.cr)  # line 3
-            out.append(Outgoing(Control(DC_TRUE if self._doubly_connected_to_all else DC_FALSE)))
+            out.append(Message(Control(DC_TRUE if self._doubly_connected_to_all else DC_FALSE)))
             if not self._doubly_connected_to_all:
                 self._decide(False, now)  # line 7
                 return

@@ -58,7 +58,7 @@ from typing import NamedTuple
 
 import networkx as nx
 
-from algorithms.connectivity.base import Outgoing, Received
+from algorithms.robot import Message
 
 #: ``(access robot, ..., reference)``; ``()`` is the reference's own announcement.
 AccessPath = tuple
@@ -209,11 +209,11 @@ class ConnectivityTable:
 
     # -- one tick ---------------------------------------------------------------------
     def tick(
-        self, now: int, inbox: Iterable[Received], neighbors: Iterable[Hashable]
-    ) -> list[Outgoing]:
+        self, now: int, inbox: Iterable[Message], neighbors: Iterable[Hashable]
+    ) -> list[Message]:
         """Handle neighbour changes and this tick's messages; return what to transmit."""
         neighbors = frozenset(neighbors)
-        out: list[Outgoing] = []
+        out: list[Message] = []
         if self._neighbors is None:
             self._neighbors = neighbors
             if self.is_reference:
@@ -224,11 +224,11 @@ class ConnectivityTable:
             for a in _canonical(lost):
                 broken = LinkBroken(self.robot_id, a, now)
                 self._drop_link(broken)
-                out.append(Outgoing(broken))
+                out.append(Message(broken))
                 self._reoffer(out)
             for b in _canonical(met):
                 entries = tuple((p, self._times(p)) for p in self._forwarded)
-                out.append(Outgoing(TableExchange(entries), to=b))
+                out.append(Message(TableExchange(entries), to=b))
         for message in inbox:
             payload = message.payload
             if isinstance(payload, NewAccessPath):
@@ -237,12 +237,12 @@ class ConnectivityTable:
                 for path, times in payload.entries:
                     self._new_access_path(message.sender, NewAccessPath(path, times), now, out)
             elif isinstance(payload, LinkBroken) and self._drop_link(payload):
-                out.append(Outgoing(payload))  # deleted something: pass the news on
+                out.append(Message(payload))  # deleted something: pass the news on
                 self._reoffer(out)
         return out
 
     def _new_access_path(
-        self, sender: Hashable, message: NewAccessPath, now: int, out: list[Outgoing]
+        self, sender: Hashable, message: NewAccessPath, now: int, out: list[Message]
     ) -> None:
         """Algorithm 1: drop loops, store ``(sender,) + path``, forward if the rule says so.
 
@@ -259,7 +259,7 @@ class ConnectivityTable:
             if fresher != known:
                 self._paths[p] = fresher
                 if p in self._forwarded:
-                    out.append(Outgoing(NewAccessPath(p, fresher)))
+                    out.append(Message(NewAccessPath(p, fresher)))
             return
         self._paths[p] = times
         if self._accepts(p):
@@ -277,10 +277,10 @@ class ConnectivityTable:
             return False
         return not remaining if self.max_forwards is not None and k == self.max_forwards - 1 else True
 
-    def _forward(self, p: AccessPath, out: list[Outgoing]) -> None:
+    def _forward(self, p: AccessPath, out: list[Message]) -> None:
         self._shared = interior(p) if not self._forwarded else self._shared & interior(p)
         self._forwarded[p] = None
-        out.append(Outgoing(NewAccessPath(p, self._times(p))))
+        out.append(Message(NewAccessPath(p, self._times(p))))
 
     def _times(self, p: AccessPath) -> tuple[int, ...]:
         """Hop times of a stored path (the reference's ``()`` has none)."""
@@ -297,7 +297,7 @@ class ConnectivityTable:
             self._shared = frozenset.intersection(*kept) if kept else frozenset()
         return bool(gone)
 
-    def _reoffer(self, out: list[Outgoing]) -> None:
+    def _reoffer(self, out: list[Message]) -> None:
         """After deletions, forward stored paths the rule now accepts (oldest first)."""
         for p in list(self._paths):
             if p not in self._forwarded and self._accepts(p):
@@ -387,8 +387,8 @@ class TableCheck:
         return 2 * self.max_robots - 1
 
     def tick(
-        self, now: int, inbox: Iterable[Received], neighbors: Iterable[Hashable]
-    ) -> list[Outgoing]:
+        self, now: int, inbox: Iterable[Message], neighbors: Iterable[Hashable]
+    ) -> list[Message]:
         """Keep the table up to date; report (or, at the reference, decide) on time."""
         if self._start is None:
             self._start = now
@@ -404,7 +404,7 @@ class TableCheck:
         elif not self._reported and table.paths:
             first = table.paths[0]
             if elapsed >= self.decision_tick - len(first):
-                out.append(Outgoing(self._subtree_report(), to=first[0]))
+                out.append(Message(self._subtree_report(), to=first[0]))
                 self._reported = True
         return out
 

@@ -72,7 +72,7 @@ from collections.abc import Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
-from algorithms.connectivity import BiconnectivityCheck, Outgoing, Received
+from algorithms.connectivity import BiconnectivityCheck
 from algorithms.maintenance.regions import (
     biconnected,
     candidate_centres,
@@ -83,6 +83,8 @@ from algorithms.maintenance.regions import (
     two_closest_sum,
     union_area,
 )
+
+from algorithms.robot import Command, Controller, Message, Observation
 
 PLACEMENTS = ("heuristic", "min-intersection")
 Point = tuple[float, float]
@@ -184,8 +186,12 @@ def least_d(ex_neighbours: Mapping[Hashable, Point], pos: Point, params: Params)
     return params.link_m
 
 
-class BiconnectedRobot:
+class BiconnectedRobot(Controller):
     """One robot of seed 002's maintenance: holds its region, joins, leads after a removal.
+
+    As a :class:`~algorithms.robot.Controller` (:meth:`step`) it reads its positioning
+    sensor and radio and answers with a planar velocity and its messages; its clock is
+    the tick number ``round(time_s / params.tick_s)`` (the team's common clock).
 
     Args:
         robot_id: unique, ordered id (Assumption 3).
@@ -242,25 +248,31 @@ class BiconnectedRobot:
             self._held = (key, hold_points(self.table, self.params.clearance_m))
         return self._held[1]
 
-    def leave(self) -> Outgoing:
+    def leave(self) -> Message:
         """The message to broadcast just before this robot is taken off the floor."""
-        return Outgoing(Leave(self.id, self.centre))
+        return Message(Leave(self.id, self.centre))
 
     # -- one control tick ---------------------------------------------------------------
-    def tick(self, now: int, inbox: Iterable[Received], neighbors: Iterable[Hashable],
-             pose: Sequence[float]) -> tuple[list[Outgoing], Point]:
+    def step(self, observation: Observation) -> Command:
+        """One control tick from the robot's positioning sensor and radio."""
+        out, velocity = self.tick(round(observation.time_s / self.params.tick_s),
+                                  observation.inbox, observation.neighbors, observation.pose)
+        return Command(velocity_m_s=tuple(velocity), messages=tuple(out))
+
+    def tick(self, now: int, inbox: Iterable[Message], neighbors: Iterable[Hashable],
+             pose: Sequence[float]) -> tuple[list[Message], Point]:
         """Handle this tick's messages; answer with messages and a planar velocity (m/s)."""
-        out: list[Outgoing] = []
+        out: list[Message] = []
         check_inbox: dict[tuple, list[_Inner]] = {}
         for m in inbox:
             p = m.payload
             if isinstance(p, Region):
                 if self.table.get(p.robot) != p.centre and p.robot != self.id:
                     self.table[p.robot] = p.centre
-                    out.append(Outgoing(p))
+                    out.append(Message(p))
             elif isinstance(p, PosRequest):
                 if self.stage is None:
-                    out.append(Outgoing(Table(dict(self.table)), to=m.sender))
+                    out.append(Message(Table(dict(self.table)), to=m.sender))
             elif isinstance(p, Table):
                 self._replies.append((m.sender, p.centres))
             elif isinstance(p, Leave):
@@ -278,11 +290,11 @@ class BiconnectedRobot:
         return out, self._velocity(pose, target)
 
     # -- adding ---------------------------------------------------------------------------
-    def _join_step(self, now: int, pose: Sequence[float], out: list[Outgoing]) -> None:
+    def _join_step(self, now: int, pose: Sequence[float], out: list[Message]) -> None:
         here = (float(pose[0]), float(pose[1]))
         if self.stage in ("ask", "ask-again") and self._asked_at is None:
             self._asked_at, self._replies = now, []
-            out.append(Outgoing(PosRequest()))
+            out.append(Message(PosRequest()))
             return
         if self.stage in ("ask", "ask-again") and now >= self._asked_at + 2:
             table: dict[Hashable, Point] = {}
@@ -311,10 +323,10 @@ class BiconnectedRobot:
             self.centre = self._target
             self.table[self.id] = self.centre
             self.stage = None
-            out.append(Outgoing(Region(self.id, self.centre)))
+            out.append(Message(Region(self.id, self.centre)))
 
     # -- removing -------------------------------------------------------------------------
-    def _on_leave(self, p: Leave, now: int, out: list[Outgoing]) -> None:
+    def _on_leave(self, p: Leave, now: int, out: list[Message]) -> None:
         held = self._hold_points()
         gone = held.get(p.robot, p.centre)
         self.table.pop(p.robot, None)
@@ -326,24 +338,24 @@ class BiconnectedRobot:
             self._lead = (p.robot, p.centre)
             self._flood_move(least_d(ex, p.centre, self.params), now, out)
 
-    def _flood_move(self, d: float, now: int, out: list[Outgoing]) -> None:
+    def _flood_move(self, d: float, now: int, out: list[Message]) -> None:
         removed, pos = self._lead
         self.moves_led += 1
         self._on_move(Move((self.id, now), pos, d, removed), out)
         self._check_at = now + math.ceil((d / self.params.v_max + self.params.settle_s)
                                          / self.params.tick_s)
 
-    def _on_move(self, p: Move, out: list[Outgoing]) -> None:
+    def _on_move(self, p: Move, out: list[Message]) -> None:
         if p.key in self._moves_seen:
             return
         self._moves_seen.add(p.key)
-        out.append(Outgoing(p))
+        out.append(Message(p))
         self.table.pop(p.removed, None)
         self.table = {k: move_towards(c, p.pos, p.d) for k, c in self.table.items()}
         if self.centre is not None:
             self.centre = self.table[self.id]
 
-    def _lead_step(self, now: int, out: list[Outgoing]) -> None:
+    def _lead_step(self, now: int, out: list[Message]) -> None:
         if self._check_at is not None:
             if now < self._check_at:
                 return
@@ -364,7 +376,7 @@ class BiconnectedRobot:
             self._flood_move(self.params.d_extra_m, now, out)
 
     def _run_checks(self, now: int, inbox: dict[tuple, list[_Inner]],
-                    neighbors: Iterable[Hashable], out: list[Outgoing]) -> None:
+                    neighbors: Iterable[Hashable], out: list[Message]) -> None:
         for key in inbox:
             if key != self._check_key and key not in self._old_checks:  # a new run
                 if self._check_key is not None:
@@ -377,8 +389,8 @@ class BiconnectedRobot:
                              neighbors, out)
 
     def _tick_check(self, key: tuple, now: int, inbox: list[_Inner],
-                    neighbors: Iterable[Hashable], out: list[Outgoing]) -> None:
-        out += [Outgoing(Check(key, m.payload), m.to)
+                    neighbors: Iterable[Hashable], out: list[Message]) -> None:
+        out += [Message(Check(key, m.payload), m.to)
                 for m in self._checks[key].tick(now, inbox, neighbors)]
 
     # -- motion ---------------------------------------------------------------------------

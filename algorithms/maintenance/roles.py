@@ -51,6 +51,7 @@ Choices where the paper is silent (all parameters are in :class:`RoleParams`):
 from __future__ import annotations
 
 import enum
+import math
 import time
 from collections.abc import Hashable, Mapping
 from dataclasses import dataclass
@@ -59,6 +60,7 @@ from typing import NamedTuple
 import numpy as np
 
 from algorithms.maintenance.gabriel import refresh_connections
+from algorithms.robot import Command, Controller, Message, Observation
 
 
 class Role(str, enum.Enum):
@@ -170,8 +172,14 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / norm if norm > 1e-12 else np.zeros(2)
 
 
-class RoleSwitchingRobot:
+class RoleSwitchingRobot(Controller):
     """One robot's controller for seed 001.
+
+    As a :class:`~algorithms.robot.Controller` (:meth:`step`) it reads its position from
+    its positioning sensor, the robots within d_s from its range-and-bearing sensor (the
+    role each shows is the signal it sets, :attr:`role`) and its radio inbox, and answers
+    with the planar velocity ``u_i / step_s`` and its messages; :meth:`tick` is the
+    paper's timestep on those inputs.
 
     Args:
         ident: the robot's id.
@@ -180,6 +188,7 @@ class RoleSwitchingRobot:
         parent, child: initial parent / child ids (repeaters, local leader, base station).
         every_step_aat: run the Acute Angle Test on every candidate every step (the
             baseline) instead of Algorithm 2.
+        step_s: the duration of one timestep (s), the control period.
 
     Counters ``angle_tests``, ``circle_tests`` and ``aat_seconds`` (wall time, s)
     accumulate the cost of the AAT.
@@ -187,8 +196,9 @@ class RoleSwitchingRobot:
 
     def __init__(self, ident: Hashable, role: Role, params: RoleParams, *,
                  parent: Hashable | None = None, child: Hashable | None = None,
-                 every_step_aat: bool = False) -> None:
+                 every_step_aat: bool = False, step_s: float = 0.15) -> None:
         self.id, self.role, self.params = ident, role, params
+        self.step_s = step_s
         self.parent, self.child = parent, child
         self.every_step_aat = every_step_aat
         self.connections: set = set()
@@ -211,6 +221,20 @@ class RoleSwitchingRobot:
         """An explorer without leader information fresher than the expiry (Sect. III-D)."""
         stamp = self.leader.stamp if self.leader is not None else 0
         return self.role is Role.EXPLORER and now - stamp > self.params.leader_expiry_steps
+
+    def step(self, observation: Observation) -> Command:
+        """One timestep from the robot's own sensors and radio (the class docstring)."""
+        x, y, yaw = observation.pose
+        detected = {k: Detected(np.array([x + d.range_m * math.cos(yaw + d.bearing_rad),
+                                          y + d.range_m * math.sin(yaw + d.bearing_rad)]),
+                                d.signal)
+                    for k, d in observation.detections.items()}
+        now = round(observation.time_s / self.step_s)
+        u, out = self.tick(now, np.array([x, y]), detected,
+                           [(m.sender, m.payload) for m in observation.inbox])
+        return Command(velocity_m_s=tuple((u / self.step_s).tolist()),
+                       messages=tuple(Message(payload, to) for to, payload in out),
+                       signal=self.role)
 
     def tick(self, now: int, x: np.ndarray, detected: Mapping[Hashable, Detected],
              inbox: list[tuple[Hashable, object]]) -> tuple[np.ndarray, list[tuple]]:

@@ -104,6 +104,30 @@ class SeekLine:
 
 
 @dataclass
+class CentreEnd:
+    """Where the centre sensor left a strip lengthwise: the strip's end.
+
+    Fed every tick while the end is watched; :meth:`update` returns the odometry
+    distance (m) half-way between the last tick with the centre on and the first tick
+    off, once the centre has stayed off for ``END_CONFIRM_TICKS`` ticks (one noisy
+    reading does not end a strip), else None.
+    """
+
+    _last_on_m: float = 0.0
+    _off_ticks: int = 0
+    _left_at_m: float = 0.0
+
+    def update(self, centre: bool, distance_m: float) -> float | None:
+        if centre:
+            self._last_on_m, self._off_ticks = distance_m, 0
+            return None
+        if self._off_ticks == 0:
+            self._left_at_m = (self._last_on_m + distance_m) / 2.0
+        self._off_ticks += 1
+        return self._left_at_m if self._off_ticks >= END_CONFIRM_TICKS else None
+
+
+@dataclass
 class FollowLine:
     """Follow a strip with the three line sensors until it ends.
 
@@ -137,25 +161,20 @@ class FollowLine:
     _position: float = 0.0
     #: while the centre sensor tracks the strip: the side sensors on with it last tick
     _holding: tuple[bool, bool] | None = None
-    _centre_left_at_m: float | None = None
-    _centre_off_ticks: int = 0
-    _last_on_m: float = 0.0  # odometry distance at the last tick the centre was on
+    _end: CentreEnd = field(default_factory=CentreEnd)
 
     def step(self, odo: Odometry, percept: Percept):
         left, centre, right = percept.line
         if centre:
             self._holding = (left, right)
-            self._centre_off_ticks = 0
-            self._last_on_m = odo.distance_m
+            self._end.update(True, odo.distance_m)
         elif self._holding is not None:
             if (left and self._holding[0]) or (right and self._holding[1]):
                 self._holding = None  # drifted sideways: a side sensor holds the strip
             else:  # the centre left the strip lengthwise: its end, once confirmed
-                if self._centre_off_ticks == 0:  # half-way between the two ticks
-                    self._centre_left_at_m = (self._last_on_m + odo.distance_m) / 2.0
-                self._centre_off_ticks += 1
-                if self._centre_off_ticks >= END_CONFIRM_TICKS:
-                    self.ended_at_m = self._centre_left_at_m
+                end = self._end.update(False, odo.distance_m)
+                if end is not None:
+                    self.ended_at_m = end
                     return None
                 return self.speed, self.speed * LINE_CURVATURE * self._position
         if left or centre or right:
@@ -190,9 +209,8 @@ class FollowSpoke:
     sensors: where edges are 45 degrees apart the inner ends of neighbouring spokes
     overlap, and a side sensor that reached one would steer the robot out along it
     (issue 13; ``fan:3:45``). The spoke's centre line beyond its inner end crosses no
-    other spoke. It ends when the centre sensor leaves the strip (``END_CONFIRM_TICKS``
-    in a row); ``ended_at_m`` is then half-way between the last tick on and the first
-    off. ``direction`` is the held heading.
+    other spoke. It ends where the centre sensor leaves the strip (:class:`CentreEnd`);
+    ``direction`` is the held heading.
     """
 
     speed: float
@@ -200,9 +218,7 @@ class FollowSpoke:
     _follow: FollowLine | None = None
     _aligned_since_m: float | None = None
     _heading: float | None = None
-    _last_on_m: float = 0.0
-    _off_ticks: int = 0
-    _left_at_m: float = 0.0
+    _end: CentreEnd = field(default_factory=CentreEnd)
 
     def step(self, odo: Odometry, percept: Percept):
         left, centre, right = percept.line
@@ -220,17 +236,12 @@ class FollowSpoke:
                     self._heading = self._follow.direction(odo.theta, last=None)
             else:
                 self._aligned_since_m = None
-            self._last_on_m = odo.distance_m
+            self._end.update(centre, odo.distance_m)
             return command
-        if centre:
-            self._last_on_m, self._off_ticks = odo.distance_m, 0
-        else:
-            if self._off_ticks == 0:
-                self._left_at_m = (self._last_on_m + odo.distance_m) / 2.0
-            self._off_ticks += 1
-            if self._off_ticks >= END_CONFIRM_TICKS:
-                self.ended_at_m = self._left_at_m
-                return None
+        end = self._end.update(centre, odo.distance_m)
+        if end is not None:
+            self.ended_at_m = end
+            return None
         return self.speed, hold_heading(odo, self._heading)
 
     def direction(self, fallback: float) -> float:

@@ -15,12 +15,14 @@ class RobotCalibration:
         track_m: distance between the driven wheels.
         line_ahead_m: how far ahead of the axle the line sensors look.
         max_speed_m_s: top forward speed.
+        line_floor_m: what a line sensor reads over the bare floor (its height).
     """
 
     wheel_radius_m: float
     track_m: float
     line_ahead_m: float
     max_speed_m_s: float
+    line_floor_m: float = 0.02
 
 
 class Odometry:

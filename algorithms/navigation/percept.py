@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+
+#: A line sensor sees a strip when its reading is this much (m) below the bare-floor
+#: reading: half the 2 mm strip thickness.
+LINE_THRESHOLD_M = 0.001
 
 
 @dataclass(frozen=True)
@@ -22,3 +27,12 @@ class Percept:
     @property
     def any_line(self) -> bool:
         return any(self.line)
+
+
+def percept(line_m: Sequence[float], ir_m: Sequence[float], encoder_rad: Sequence[float],
+            line_floor_m: float) -> Percept:
+    """A robot's raw readings (m, m, rad) as a :class:`Percept`: a line sensor sees a
+    strip when it reads at least ``LINE_THRESHOLD_M`` less than over the bare floor
+    (``line_floor_m``); a NaN reading (nothing within range) compares false: no strip."""
+    line = tuple(line_floor_m - d > LINE_THRESHOLD_M for d in line_m)
+    return Percept(line, tuple(float(d) for d in ir_m), tuple(float(e) for e in encoder_rad))

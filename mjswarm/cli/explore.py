@@ -63,7 +63,6 @@ def run_embodied(args) -> dict:
         wheel_slip=_or(args.wheel_slip, 0.0))
     run = EmbodiedExploration(spec, make_minds(args.strategy, args.robots, args.seed), config,
                               args.seed)
-    check_writable(args.json, "JSON")
     if args.record:
         with atomic_output(args.record, "recording") as temp, \
                 Recorder(temp, spec, args.robots, radio=args.radio_range is not None) \

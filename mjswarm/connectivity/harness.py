@@ -1,8 +1,9 @@
 """Static message-passing harness: run a connectivity method on a team to its decision.
 
-Each tick the radio delivers last tick's messages, then every robot (in team order) reads
-its inbox, sees its neighbours and answers with messages to send; one tick is the papers'
-c. The harness counts messages from the radio's counters and stops at the deciding robot's
+Each tick every robot (in team order) reads its inbox, sees its neighbours and answers
+with messages to send, which the radio delivers at the end of the tick; one tick is the
+papers' c. The robots are :class:`~algorithms.connectivity.participant.Participant`
+controllers in a :class:`StaticWorld`, run by the one :class:`~mjswarm.loop.Loop`. The harness counts messages from the radio's counters and stops at the deciding robot's
 decision: the initiator (``stamps``, seed 002 Algorithm 3: tick 6N + 2 at the latest) or
 the reference (``tables`` / ``tables-2``, seed 004 with the gathering of
 :class:`algorithms.connectivity.TableCheck`: tick 2N - 1).
@@ -18,9 +19,14 @@ from __future__ import annotations
 from collections.abc import Callable, Hashable, Mapping
 from dataclasses import asdict, dataclass
 
+import numpy as np
+
 from algorithms.connectivity import BiconnectivityCheck, TableCheck
+from algorithms.connectivity.participant import MessagePassing, Participant
+from algorithms.robot import Command, Observation
 from mjswarm.connectivity.team import Team
 from mjswarm.errors import MjswarmError
+from mjswarm.loop import Loop, LoopFunctions, World
 from mjswarm.radio import Radio
 
 #: Method names: seed 002's stamps, seed 004's tables and its forward-two variant.
@@ -55,9 +61,60 @@ class CheckResult:
         return asdict(self)
 
 
+class StaticWorld(World):
+    """Robots that stand still and only talk: the harness's world. Robot ids are the
+    radio's (any hashables); one control tick is one time unit, the papers' c."""
+
+    def __init__(self, radio: Radio, start: int = 0) -> None:
+        self.radio = radio
+        self.ids = radio.robots
+        self.n = len(self.ids)
+        self.present = np.ones(self.n, bool)
+        self.control_dt_s = 1.0
+        self.uplinks = {}
+        self._now = start
+
+    @property
+    def time_s(self) -> float:
+        return float(self._now)
+
+    def true_poses(self) -> np.ndarray:
+        return np.zeros((self.n, 3))
+
+    def active(self) -> list[Hashable]:
+        return list(self.radio.present)
+
+    def observe(self, i: Hashable) -> Observation:
+        inbox, neighbors = self._inbox(i)
+        return Observation(i, self.time_s, inbox=inbox, neighbors=neighbors)
+
+    def act(self, i: Hashable, command: Command) -> None:
+        self._send(i, command.messages)
+
+    def step(self) -> None:
+        self.radio.step()
+        self._now += 1
+
+
+class _Until(LoopFunctions):
+    """Stops the harness when ``until()`` holds after a tick, or once more than ``cap``
+    messages were sent (checked after each robot's turn)."""
+
+    def __init__(self, until: Callable[[], bool], cap: int | None) -> None:
+        self.until, self.cap, self.capped = until, cap, False
+
+    def after_act(self, loop: Loop, robot: Hashable) -> None:
+        if self.cap is not None and loop.world.radio.total_sent > self.cap:
+            self.capped = True
+            loop.stop()
+
+    def should_stop(self, loop: Loop) -> bool:
+        return self.until()
+
+
 def drive(
     radio: Radio,
-    robots: Mapping[Hashable, object],
+    robots: Mapping[Hashable, MessagePassing],
     until: Callable[[], bool],
     *,
     start: int = 0,
@@ -66,20 +123,20 @@ def drive(
 ) -> tuple[int, bool]:
     """Run ticks ``start, start + 1, ...`` until ``until()`` holds after a tick.
 
-    ``robots`` maps radio ids to objects with ``tick(now, inbox, neighbors)``. Returns
-    ``(last tick, capped)``; capped means more than ``message_cap`` messages were sent
-    (checked after each robot's turn, so a dense flood cannot run away within a tick).
+    ``robots`` maps radio ids to message-passing minds (``tick(now, inbox, neighbors)``),
+    each run as a :class:`~algorithms.connectivity.participant.Participant` by one
+    :class:`~mjswarm.loop.Loop` in a :class:`StaticWorld`. A tick's messages are
+    delivered at its end (``radio.last_batch`` counts them). Returns ``(last tick,
+    capped)``; capped means more than ``message_cap`` messages were sent (checked after
+    each robot's turn, so a dense flood cannot run away within a tick).
     """
-    for now in range(start, start + max_ticks):
-        radio.step()
-        for rid, robot in robots.items():
-            for message in robot.tick(now, radio.receive(rid), radio.neighbors(rid)):
-                radio.send(rid, message.payload, message.to)
-            if message_cap is not None and radio.total_sent > message_cap:
-                return now, True
-        if until():
-            return now, False
-    raise RuntimeError(f"no decision within {max_ticks} ticks")
+    stop = _Until(until, message_cap)
+    loop = Loop(StaticWorld(radio, start), {r: Participant(m) for r, m in robots.items()},
+                [stop])
+    loop.run(max_ticks=max_ticks)
+    if not loop.stopped:
+        raise RuntimeError(f"no decision within {max_ticks} ticks")
+    return start + loop.ticks - 1, stop.capped
 
 
 def run_check(

@@ -1,0 +1,123 @@
+"""The robot type: what one robot senses, what it does, and the controller in between.
+
+Every robot in every world is a :class:`Controller` (ARGoS's ``CCI_Controller``: Init /
+ControlStep / Reset): once per control tick the world hands it an :class:`Observation`
+and applies the :class:`Command` it answers with. An observation holds only what a real
+robot could have in that tick:
+
+* its own sensors: the Spark V's three down-looking line rangefinders and three IR
+  rangefinders (m, NaN = nothing in range), wheel encoders (rad) and speeds (rad/s) and
+  battery voltage (V); on the open floor its positioning sensor's pose (the papers
+  assume robots know their positions: UWB or motion capture), with its noise;
+* what its exteroceptive sensors report of other robots: bearings (rad, robot frame)
+  from the bearing sensor, and range-and-bearing detections with the signal each robot
+  shows (an LED colour, or the data byte of a range-and-bearing board as on ARGoS's
+  e-puck), keyed by the id the sensor reports;
+* the radio messages it received and its current radio neighbours (link-layer
+  knowledge, seed 004's MANET layer);
+* the beacon handle of the vertex whose centre it stands on, else None.
+
+It never holds another robot's pose, the arena graph or the contact list:
+``tests/test_robot_type.py`` pins the field list. One :class:`Message` type carries
+every message of the project, robot to robot and robot to vertex station.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Hashable, Mapping, Sequence
+from types import MappingProxyType
+from typing import Any, NamedTuple
+
+
+class Message(NamedTuple):
+    """One message: its payload, its addressee (None: a one-hop broadcast) and its
+    sender (filled in by the radio on delivery; None on an outgoing message)."""
+
+    payload: Any
+    to: Hashable | None = None
+    sender: Hashable | None = None
+
+
+class Detection(NamedTuple):
+    """One robot seen by a range-and-bearing sensor: range (m), bearing (rad, in the
+    observer's frame, counter-clockwise from its heading) and the signal it shows."""
+
+    range_m: float
+    bearing_rad: float
+    signal: Hashable | None = None
+
+
+#: An empty, read-only mapping (the default of the observation's mappings).
+NOTHING: Mapping = MappingProxyType({})
+
+
+class Observation(NamedTuple):
+    """What one robot senses in one control tick (see the module docstring).
+
+    Attributes:
+        robot: the robot's own id.
+        time_s: its clock (s).
+        line_m: line rangefinders (left, centre, right), m, NaN = nothing within range;
+            None where the robot has none (as every sensor below).
+        ir_m: IR rangefinders (left, front, right), m, NaN = nothing within range.
+        encoder_rad: wheel encoders (left, right), rad.
+        wheel_speed_rad_s: wheel speeds (left, right), rad/s.
+        battery_v: battery voltage, V.
+        pose: positioning-sensor reading (x m, y m, yaw rad) on the open floor, else None.
+        bearings: bearing (rad) to each robot the bearing sensor sees, by reported id.
+        detections: range-and-bearing detections, by reported id.
+        inbox: messages received this tick, in delivery order.
+        neighbors: ids the radio hears this tick.
+        beacon: the beacon of the vertex whose centre the robot stands on, else None.
+    """
+
+    robot: Hashable
+    time_s: float
+    line_m: Sequence[float] | None = None
+    ir_m: Sequence[float] | None = None
+    encoder_rad: Sequence[float] | None = None
+    wheel_speed_rad_s: Sequence[float] | None = None
+    battery_v: float | None = None
+    pose: tuple[float, float, float] | None = None
+    bearings: Mapping[Hashable, float] = NOTHING
+    detections: Mapping[Hashable, Detection] = NOTHING
+    inbox: Sequence[Message] = ()
+    neighbors: frozenset = frozenset()
+    beacon: Any = None
+
+
+class Command(NamedTuple):
+    """What one robot does in one control tick.
+
+    Attributes:
+        v_m_s, omega_rad_s: unicycle command, forward speed (m/s) and turn rate (rad/s).
+        velocity_m_s: a planar velocity (m/s, world frame) instead; the open floor's
+            tracker (:func:`algorithms.motion.track_velocity`) turns it into ``(v, omega)``
+            from the robot's sensed heading.
+        messages: what it transmits (one-hop broadcasts, or addressed ones).
+        signal: what it shows to other robots' range-and-bearing sensors from now on
+            (None: keep showing the previous signal).
+    """
+
+    v_m_s: float = 0.0
+    omega_rad_s: float = 0.0
+    velocity_m_s: tuple[float, float] | None = None
+    messages: tuple[Message, ...] = ()
+    signal: Hashable | None = None
+
+
+#: The command of a robot that stands still and says nothing.
+STOP = Command()
+
+
+class Controller(ABC):
+    """One robot's mind: :meth:`reset` when it is put into a world, then :meth:`step`
+    once per control tick."""
+
+    def reset(self) -> None:  # noqa: B027 - a hook: most controllers keep no episode state
+        """Called when the robot is (re)placed in a world, before its first step."""
+
+    @abstractmethod
+    def step(self, observation: Observation) -> Command:
+        """Answer one tick's observation with a command."""

@@ -1,0 +1,227 @@
+"""One loop runs any world with any controllers, and loop functions own the experiment.
+
+The split is ARGoS's (controllers vs loop functions) with dm_control composer's
+lifecycle hooks. A :class:`World` is the robots' surroundings at some fidelity (MuJoCo
+dynamics on an arena or an open floor, kinematic points): it turns the world state into
+each robot's :class:`~algorithms.robot.Observation`, applies each
+:class:`~algorithms.robot.Command` and advances one control tick, radio included. A
+:class:`LoopFunctions` object is the experimenter: it launches and removes robots,
+keeps the vertex stations, injects faults, measures and records. Only loop functions see
+ground truth (:meth:`World.true_poses`, contacts); controllers see observations.
+
+One control tick (:meth:`Loop.step`)::
+
+    for f in functions: f.before_step(loop)
+    for i in world.active():                   # robots on the floor, in id order
+        command = controllers[i].step(world.observe(i))
+        world.act(i, command)                  # motion set-point, messages, signal
+        for f in functions: f.after_act(loop, i)
+    world.step()                               # physics, then the radio delivers
+    for f in functions: f.after_step(loop)
+    stop = any(f.should_stop(loop) for f in functions)
+
+Messages sent in a tick are delivered at the end of that tick's ``world.step()`` and read
+in the next tick's observations: the radio's one tick of latency (seed 002 Assumption 4).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from algorithms.robot import Command, Controller, Message, Observation
+from mjswarm.errors import MjswarmError
+from mjswarm.radio import Radio
+
+class World(ABC):
+    """The surface a :class:`Loop` drives: ``observe``, ``act``, ``step``, and ground truth
+    for loop functions, metrics and recordings only.
+
+    Robots are ids ``0 .. n - 1``; ``present[i]`` says whether robot ``i`` is on the
+    floor (absent robots wait in a depot, off the air and unseen). A world may carry a
+    :class:`~mjswarm.radio.Radio` (``radio``); it relinks the radio from the true
+    positions of present robots after every step.
+    """
+
+    n: int
+    present: np.ndarray
+    radio: Radio | None = None
+    #: infrastructure links by address (:class:`~mjswarm.radio.Uplink`); set per world
+    uplinks: dict
+    #: control period (s)
+    control_dt_s: float
+
+    @property
+    @abstractmethod
+    def time_s(self) -> float:
+        """Simulated time (s)."""
+
+    @abstractmethod
+    def true_poses(self) -> np.ndarray:
+        """Ground truth, shape (N, 3): x, y (m), yaw (rad). Not for controllers."""
+
+    @abstractmethod
+    def observe(self, i: int) -> Observation:
+        """Robot ``i``'s observation of this tick."""
+
+    @abstractmethod
+    def act(self, i: int, command: Command) -> None:
+        """Apply robot ``i``'s command: its motion set-point, messages and signal."""
+
+    @abstractmethod
+    def step(self) -> None:
+        """Advance one control tick (physics, then the radio)."""
+
+    def active(self) -> list[int]:
+        """The robots the loop steps this tick: those on the floor."""
+        return np.flatnonzero(self.present).tolist()
+
+    @property
+    def contacts(self) -> int | None:
+        """Robot-robot contact events so far (None: a world without bodies)."""
+        return None
+
+    # -- the radio, shared by every world ----------------------------------------------
+    def attach_radio(self, radio: Radio) -> None:
+        """Give every robot this radio (ids ``0 .. n - 1``); absent robots are off the air."""
+        if set(radio.robots) != set(range(self.n)):
+            raise MjswarmError("the radio must know exactly the robots 0 .. n - 1")
+        self.radio = radio
+        for i in range(self.n):
+            if not self.present[i]:
+                radio.remove(i)
+        self.relink()
+
+    def set_on_air(self, i: int, on: bool) -> None:
+        """Robot ``i`` joins (``on``) or leaves the radio (what it had not read is lost)."""
+        if self.radio is not None:
+            if on:
+                self.radio.restore(i)
+            else:
+                self.radio.remove(i)
+
+    def relink(self) -> None:
+        """Move the radio's links to where the robots are now."""
+        if self.radio is not None and self.radio.range_m is not None:
+            self.radio.move(self._air_positions())
+
+    def _air_positions(self) -> dict[int, np.ndarray]:
+        xy = self.true_poses()[:, :2]
+        return {i: xy[i] for i in self.radio.present}
+
+    def _radio_step(self) -> None:
+        """End of a tick: deliver this tick's messages, relink from the new positions."""
+        if self.radio is not None:
+            self.radio.step(self._air_positions() if self.radio.range_m is not None else None)
+        for link in self.uplinks.values():
+            link.step()
+
+    def _inbox(self, i: int) -> tuple[Sequence[Message], frozenset]:
+        """Robot ``i``'s messages (radio, then infrastructure) and radio neighbours."""
+        inbox, neighbors = ([], frozenset()) if self.radio is None else (
+            self.radio.receive(i), self.radio.neighbors(i))
+        for link in self.uplinks.values():
+            inbox += link.receive_for(i)
+        return inbox, neighbors
+
+    def _send(self, i: int, messages: Sequence[Message]) -> None:
+        for m in messages:
+            if m.to in self.uplinks:
+                self.uplinks[m.to].send(i, m.payload)
+            elif self.radio is None:
+                raise MjswarmError(f"robot {i} sent a message but the world has no radio")
+            else:
+                self.radio.send(i, m.payload, m.to)
+
+
+class LoopFunctions:
+    """Hooks the loop calls; override the ones an experiment needs (all optional)."""
+
+    def initialize(self, loop: Loop) -> None:
+        """Before the first tick: place robots, set up stations, radios, recorders."""
+
+    def before_step(self, loop: Loop) -> None:
+        """Start of a tick, before any robot acts (launches, faults, station grants)."""
+
+    def after_act(self, loop: Loop, robot: int) -> None:
+        """After one robot's command was applied (e.g. a message cap)."""
+
+    def after_step(self, loop: Loop) -> None:
+        """After the world stepped (measurements, recording)."""
+
+    def should_stop(self, loop: Loop) -> bool:
+        """Whether the run is over."""
+        return False
+
+    def result(self, loop: Loop) -> Any:
+        """What the run measured (the experiment's result object)."""
+        return None
+
+
+class Loop:
+    """Runs ``controllers`` (by robot id) in ``world`` with ``functions``' hooks.
+
+    ``stopped`` holds the robots the loop no longer steps (a controller that ended, a
+    robot that failed); loop functions add to it with :meth:`halt`.
+    """
+
+    def __init__(self, world: World, controllers: Mapping[int, Controller],
+                 functions: Iterable[LoopFunctions] = ()) -> None:
+        self.world = world
+        self.controllers: dict[int, Controller] = dict(controllers)
+        self.functions = list(functions)
+        self.ticks = 0
+        self.halted: set[int] = set()
+        self._stop = False
+        base = LoopFunctions.after_act
+        self._after_act = [f for f in self.functions if type(f).after_act is not base]
+        for f in self.functions:
+            f.initialize(self)
+
+    def halt(self, robot: int) -> None:
+        """Stop stepping ``robot`` for good (its body stays where it is, standing still)."""
+        self.halted.add(robot)
+        self.world.act(robot, Command())
+
+    def stop(self) -> None:
+        """End the run after the current tick (from a hook)."""
+        self._stop = True
+
+    def step(self) -> None:
+        """One control tick (module docstring)."""
+        world, controllers = self.world, self.controllers
+        for f in self.functions:
+            f.before_step(self)
+        for i in world.active():
+            if i in self.halted:
+                continue
+            world.act(i, controllers[i].step(world.observe(i)))
+            for f in self._after_act:
+                f.after_act(self, i)
+            if self._stop:
+                break
+        world.step()
+        self.ticks += 1
+        for f in self.functions:
+            f.after_step(self)
+        if any(f.should_stop(self) for f in self.functions):
+            self._stop = True
+
+    def run(self, max_ticks: int | None = None,
+            on_tick: Callable[[Loop], None] | None = None) -> list[Any]:
+        """Step until a loop function stops the run (or ``max_ticks``); the results of
+        every loop function, in order. A later call runs on from where it stopped."""
+        self._stop = False
+        while not self._stop and (max_ticks is None or self.ticks < max_ticks):
+            self.step()
+            if on_tick is not None:
+                on_tick(self)
+        return [f.result(self) for f in self.functions]
+
+    @property
+    def stopped(self) -> bool:
+        return self._stop
+

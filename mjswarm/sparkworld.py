@@ -1,0 +1,101 @@
+"""Spark V robots in MuJoCo as a :class:`~mjswarm.loop.World`.
+
+:class:`SparkWorld` wraps a :class:`~mjswarm.simulation.Simulation` (an arena, the
+bench's rows, any world from :func:`mjswarm.world.world_spec`). Each tick a robot
+observes its own rangefinders, encoders, wheel speeds and battery (the simulation's
+sensor record), the bearings its :class:`~mjswarm.bearing.BearingSensor` reports, its
+radio, and the beacon under it when the loop functions keep beacons (``beacon_at``);
+its ``(v, omega)`` command goes to the wheels through the model's motors. The radio's
+links need line of sight both ways (:func:`mjswarm.awareness.sight_blocker`).
+
+Every robot is on the floor unless a loop function says otherwise (``present``: robots
+waiting in a depot off the arena are neither stepped nor on the air).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from algorithms.robot import NOTHING, Command, Observation
+from mjswarm.bearing import BearingSensor
+from mjswarm.loop import World
+from mjswarm.simulation import Simulation
+
+
+class SparkWorld(World):
+    """Args:
+        sim: the MuJoCo world.
+        bearing: the robots' bearing sensor (None: robots have none).
+        present: which robots are on the floor (default all).
+        beacon_at: ``beacon_at(i)``, the beacon robot ``i`` can read now (the station of
+            the vertex whose centre it stands on), else None; set by loop functions.
+    """
+
+    def __init__(self, sim: Simulation, bearing: BearingSensor | None = None,
+                 present: np.ndarray | None = None,
+                 beacon_at: Callable[[int], Any] | None = None) -> None:
+        self.sim = sim
+        self.n = sim.n
+        self.present = np.ones(self.n, bool) if present is None else np.array(present, bool)
+        self.control_dt_s = sim.control_dt_s
+        self.bearing = bearing
+        self.beacon_at = beacon_at
+        self.uplinks = {}
+        self._v = np.zeros(self.n)
+        self._w = np.zeros(self.n)
+        self._version = -1
+        self._columns: tuple = ()
+        self._bearings: list[dict] | None = None
+
+    @property
+    def time_s(self) -> float:
+        return self.sim.time_s
+
+    def true_poses(self) -> np.ndarray:
+        return self.sim.poses()
+
+    @property
+    def contacts(self) -> int:
+        return self.sim.collisions.count
+
+    def observe(self, i: int) -> Observation:
+        if self._version != self.sim.state_version:  # one read of every sensor per state
+            r = self.sim.readings()
+            self._columns = (r["line"].tolist(), r["ir"].tolist(), r["encoder"].tolist(),
+                             r["wheel_speed"].tolist(), r["battery"].tolist())
+            self._bearings = self.bearing.read() if self.bearing is not None else None
+            self._version = self.sim.state_version
+        line, ir, encoder, wheel_speed, battery = self._columns
+        inbox, neighbors = self._inbox(i)
+        return Observation(
+            i, self.sim.time_s, line[i], ir[i], encoder[i], wheel_speed[i], battery[i],
+            bearings=NOTHING if self._bearings is None else self._bearings[i],
+            inbox=inbox, neighbors=neighbors,
+            beacon=None if self.beacon_at is None else self.beacon_at(i))
+
+    def bearing_readings(self) -> list[dict[int, float]]:
+        """What every robot's bearing sensor reported at the last observed state (for
+        recordings; empty without a bearing sensor)."""
+        return self._bearings if self._bearings is not None else [{} for _ in range(self.n)]
+
+    def act(self, i: int, command: Command) -> None:
+        self._v[i], self._w[i] = command.v_m_s, command.omega_rad_s
+        if command.messages:
+            self._send(i, command.messages)
+
+    def step(self) -> None:
+        self.sim.set_velocity(self._v, self._w)
+        self.sim.step()
+        self._radio_step()
+
+    def place(self, i: int, pose) -> None:
+        """Put robot ``i`` on the floor at ``pose`` (:class:`~mjswarm.world.Pose2D`), at
+        rest, and on the air (the experimenter's hand)."""
+        self.sim.place_robot(i, pose)
+        self.present[i] = True
+        self._v[i] = self._w[i] = 0.0
+        self.set_on_air(i, True)
+        self.relink()
