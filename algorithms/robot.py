@@ -121,3 +121,7 @@ class Controller(ABC):
     @abstractmethod
     def step(self, observation: Observation) -> Command:
         """Answer one tick's observation with a command."""
+
+    def telemetry(self) -> Mapping[str, float]:
+        """Named numbers that describe its state now, for recordings (none by default)."""
+        return NOTHING

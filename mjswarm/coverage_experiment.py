@@ -44,6 +44,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -54,6 +55,7 @@ from mjswarm.loop import Loop, LoopFunctions
 from mjswarm.openfloor import EmbodiedFloor, MotionWorld, PointWorld
 from mjswarm.robot import spark_v_geometry
 from mjswarm.radio import Radio
+from mjswarm.recording import Recorder, Recording
 
 MAX_ROBOTS = 10
 START_ROBOTS = 5
@@ -123,11 +125,13 @@ class CoverageRun(LoopFunctions):
         region_diameter_m: D, the diameter of every region (m).
         max_ticks: an episode that has not settled by then raises :class:`MjswarmError`.
         clearance_m: distance robots keep (m); default ``CLEARANCE_M`` embodied, 0 points.
+        recorder: a :class:`~mjswarm.recording.Recorder` for ``MAX_ROBOTS`` robots without
+            sensors (:func:`recorder_for`), or None.
     """
 
     def __init__(self, cr: float, placement: str = "heuristic", world: str = "point",
                  seed: int = 0, region_diameter_m: float = 1.0, max_ticks: int = 20_000,
-                 clearance_m: float | None = None) -> None:
+                 clearance_m: float | None = None, recorder: Recorder | None = None) -> None:
         if not (math.isfinite(cr) and cr > 1.0):
             raise MjswarmError(f"cr must be a number above 1, got {cr}")
         if placement not in PLACEMENTS:
@@ -161,7 +165,8 @@ class CoverageRun(LoopFunctions):
             self.world = EmbodiedFloor(starts, present=absent, seed=seed,
                                        floor_half_size_m=half, control_dt_s=tick)
         self.world.attach_radio(Radio(range(MAX_ROBOTS), range_m=self.params.link_m))
-        self.loop = Loop(self.world, {}, [self])
+        self.recording = Recording(recorder) if recorder is not None else None
+        self.loop = Loop(self.world, {}, [self] + ([self.recording] if self.recording else []))
         self._ticks = 0
         for _ in range(START_ROBOTS):
             self._episode("add", -1)
@@ -215,6 +220,8 @@ class CoverageRun(LoopFunctions):
             radio.step()
             world.place(robot, None)
             self.minds.pop(robot)
+        if self.recording is not None:
+            self.recording.event(self.loop, f"episode {index}: {action} R{robot + 1}", robot)
         before = {k: (m.moves_led, m.checks_led) for k, m in self.minds.items()}
         self._ticks = 0
         self.loop.run()
@@ -262,14 +269,28 @@ class CoverageRun(LoopFunctions):
             offset += 0.1
 
 
+def recorder_for(path: str | Path, cr: float, world: str,
+                 region_diameter_m: float = 1.0) -> Recorder:
+    """A recorder for a coverage run: ``MAX_ROBOTS`` robots, radios, no arena."""
+    half = 3.0 * region_diameter_m * cr
+    return Recorder(path, None, MAX_ROBOTS, radio=True, sensors=False,
+                    bounds_m=(-half, -half, half, half),
+                    name=f"biconnected coverage, cr {cr:g}, {world} world")
+
+
 def run_coverage(cr: float, placement: str = "heuristic", episodes: int = 100,
                  seed: int = 0, world: str = "embodied", region_diameter_m: float = 1.0,
-                 progress: Callable[[], None] | None = None) -> CoverageResult:
-    """Build the team of 5 and run ``episodes`` random add / remove episodes."""
+                 progress: Callable[[], None] | None = None,
+                 record: str | Path | None = None) -> CoverageResult:
+    """Build the team of 5 and run ``episodes`` random add / remove episodes; with
+    ``record``, write a rerun recording there."""
     if episodes < 1:
         raise MjswarmError(f"need at least one episode, got {episodes}")
-    run = CoverageRun(cr, placement, world, seed, region_diameter_m)
-    return run.run(episodes, progress)
+    if record is None:
+        return CoverageRun(cr, placement, world, seed, region_diameter_m).run(episodes, progress)
+    with recorder_for(record, cr, world, region_diameter_m) as recorder:
+        run = CoverageRun(cr, placement, world, seed, region_diameter_m, recorder=recorder)
+        return run.run(episodes, progress)
 
 
 __all__ = ["CoverageResult", "CoverageRun", "Episode", "run_coverage"]

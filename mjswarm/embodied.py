@@ -49,6 +49,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -563,10 +564,12 @@ class EmbodiedExploration(LoopFunctions):
         )
 
 
-def explore_embodied(spec: ArenaSpec, n_robots: int, strategy: str = "incidence-dfs",
+def explore_embodied(spec: ArenaSpec, n_robots: int,
+                     strategy: str | Callable[..., Strategy] = "incidence-dfs",
                      config: EmbodiedConfig | None = None, seed: int | None = None,
                      recorder=None, progress: bool = False) -> EmbodiedResult:
-    """Explore ``spec`` with ``n_robots`` embodied robots running ``strategy``."""
+    """Explore ``spec`` with ``n_robots`` embodied robots running ``strategy`` (a name
+    from ``STRATEGIES`` or a factory ``(index, n_robots, rng) -> Strategy``)."""
     minds = make_minds(strategy, n_robots, seed)
     run = EmbodiedExploration(spec, minds, config or EmbodiedConfig(), seed, recorder)
     return run.run(progress=progress)

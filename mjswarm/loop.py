@@ -75,6 +75,10 @@ class World(ABC):
     def step(self) -> None:
         """Advance one control tick (physics, then the radio)."""
 
+    @abstractmethod
+    def commanded_speeds(self) -> np.ndarray:
+        """Each robot's commanded forward speed (m/s) in the last tick, shape (N,)."""
+
     def active(self) -> list[int]:
         """The robots the loop steps this tick: those on the floor."""
         return np.flatnonzero(self.present).tolist()

@@ -75,6 +75,7 @@ class MotionWorld(World, ABC):
         self._commands: list[Command] = [Command()] * self.n
         self.signals: list = [None] * self.n
         self.uplinks = {}
+        self._speeds = np.zeros(self.n)
         self._sensed: np.ndarray | None = None  # this tick's positioning-sensor readings
         self._detections: list[dict] | None = None
 
@@ -131,9 +132,13 @@ class MotionWorld(World, ABC):
             else:
                 v[i], omega[i] = c.v_m_s, c.omega_rad_s
         self._advance(v, omega, self.control_dt_s)
+        self._speeds = v
         self._time_s += self.control_dt_s
         self._sensed = self._detections = None
         self._radio_step()
+
+    def commanded_speeds(self) -> np.ndarray:
+        return self._speeds.copy()
 
     def show(self, i: int, signal) -> None:
         """The experimenter sets what robot ``i`` shows (e.g. its initial role)."""

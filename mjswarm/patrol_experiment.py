@@ -36,6 +36,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 
 import networkx as nx
 import numpy as np
@@ -54,6 +55,7 @@ from mjswarm.errors import MjswarmError
 from mjswarm.loop import Loop, LoopFunctions
 from mjswarm.openfloor import EmbodiedFloor, MotionWorld, PointWorld
 from mjswarm.radio import Radio
+from mjswarm.recording import Recorder, Recording
 
 #: Duration of one paper timestep (s): 0.03 m/step = 0.2 m/s, 0.15 rad/step = 1 rad/s.
 STEP_S = 0.15
@@ -151,6 +153,9 @@ class Timed(Controller):
         spent[1] += 1
         return command
 
+    def telemetry(self):
+        return self.inner.telemetry()
+
 
 def network_graph(minds: list[RoleSwitchingRobot], xy: np.ndarray, d_c: float) -> nx.Graph:
     """Mutual connections no longer than ``d_c`` (ground-truth positions ``xy``, m)."""
@@ -195,6 +200,12 @@ class PatrolMission(LoopFunctions):
         self.history: dict[str, list] = {"positions": [], "roles": [], "edges": []}
         self._flock_base = nx.Graph()
         self._acted_from = np.zeros((robots, 2))  # true positions at the tick's start
+        self.recording: Recording | None = None
+        self._roles = [m.role for m in minds]
+
+    def _event(self, loop: Loop, text: str, robot: int | None = None) -> None:
+        if self.recording is not None:
+            self.recording.event(loop, text, robot)
 
     def new_target(self, seq: int) -> Target:
         """A target drawn in the target square (the simulator informs the base station)."""
@@ -250,6 +261,12 @@ class PatrolMission(LoopFunctions):
         if base_station.target is not None and base_station.arrived >= base_station.target.seq:
             self.targets += 1
             base_station.target = self.new_target(base_station.target.seq + 1)
+            self._event(loop, f"target {self.targets} reached; next at "
+                              f"({base_station.target.x[0]:.2f}, {base_station.target.x[1]:.2f}) m")
+        for i, m in enumerate(minds):
+            if m.role is not self._roles[i]:
+                self._event(loop, f"R{i + 1}: {self._roles[i].value} -> {m.role.value}", i)
+                self._roles[i] = m.role
         if self.progress is not None:
             self.progress(1)
 
@@ -257,10 +274,10 @@ class PatrolMission(LoopFunctions):
 def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
               params: RoleParams | None = None, every_step_aat: bool = False,
               sample_every: int = 10, progress: Callable[[int], None] | None = None,
-              keep_history: bool = False) -> TrialResult:
+              keep_history: bool = False, recorder: Recorder | None = None) -> TrialResult:
     """One patrol mission of ``steps`` timesteps with ``robots`` robots (base station
     included). ``every_step_aat`` drives the robots with the baseline instead of
-    Algorithm 2."""
+    Algorithm 2; ``recorder`` (:func:`recorder_for`) records the mission."""
     params = params or RoleParams()
     if steps < 1 or sample_every < 1:
         raise MjswarmError("steps and sample interval must be at least 1")
@@ -279,7 +296,11 @@ def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
     floor = make_world(world, xy0, seed, params.d_s)
     floor.attach_radio(Radio(range(robots), range_m=params.d_c, rng=seed))
     timed = [Timed(m) for m in minds]
-    loop = Loop(floor, dict(enumerate(timed)), [mission])
+    functions: list[LoopFunctions] = [mission]
+    if recorder is not None:
+        mission.recording = Recording(recorder)
+        functions.append(mission.recording)
+    loop = Loop(floor, dict(enumerate(timed)), functions)
     loop.run(max_ticks=steps)
     robot_steps = robots * steps
     cpu_by_role: dict[str, list[float]] = {r.value: [0.0, 0] for r in Role}
@@ -350,15 +371,30 @@ def summarize(trials: list[TrialResult]) -> dict:
     }
 
 
+def recorder_for(path: str | Path, robots: int, world: str) -> Recorder:
+    """A recorder for one mission: the robots, their radios, the target square."""
+    side = 1.8 * math.sqrt(robots)
+    return Recorder(path, None, robots, radio=True, sensors=False,
+                    bounds_m=(0.0, 0.0, side, side), name=f"patrol, N = {robots}, {world} world")
+
+
 def run_patrol(robots: int, trials: int = 1, seed: int = 0, world: str = "embodied",
                steps: int = 2000, params: RoleParams | None = None,
                every_step_aat: bool = False,
-               progress: Callable[[int], None] | None = None) -> dict:
-    """``trials`` missions (seeds ``seed .. seed + trials - 1``), summarised."""
+               progress: Callable[[int], None] | None = None,
+               record: str | Path | None = None) -> dict:
+    """``trials`` missions (seeds ``seed .. seed + trials - 1``), summarised; with
+    ``record``, a rerun recording of the (single) mission is written there."""
     if trials < 1:
         raise MjswarmError(f"need at least one trial, got {trials}")
     if world not in WORLDS:
         raise MjswarmError(f"unknown world {world!r} (choose from {', '.join(WORLDS)})")
+    if record is not None:
+        if trials != 1:
+            raise MjswarmError(f"a recording holds one mission; got {trials} trials")
+        with recorder_for(record, robots, world) as recorder:
+            return summarize([run_trial(robots, seed, world, steps, params, every_step_aat,
+                                        progress=progress, recorder=recorder)])
     results = [run_trial(robots, seed + k, world, steps, params, every_step_aat,
                          progress=progress) for k in range(trials)]
     return summarize(results)

@@ -74,6 +74,7 @@ import rerun.blueprint as rrb
 from mjswarm.arena.builder import arena_primitives
 from mjswarm.arena.spec import ArenaSpec
 from mjswarm.errors import MjswarmError, one_line
+from mjswarm.loop import Loop, LoopFunctions
 from mjswarm.robot import ENCODERS, IR_SENSORS, LINE_SENSORS
 
 if TYPE_CHECKING:
@@ -186,12 +187,17 @@ class Recorder:
 
     Args:
         path: the ``.rrd`` file to write (its directory must exist).
-        arena: the arena the run happens in (drawn as static data).
+        arena: the arena the run happens in (drawn as static data); None for an open floor.
         n_robots: team size; robots are R1..RK (indices 0..K-1 in the methods).
         robot_radius_m: body radius for drawing (m).
         chunk_ticks: ticks buffered between columnar sends.
         trail_window_s: simulated seconds of trail the blueprint shows.
         radio: whether the run has radios (the blueprint then shows the radio views).
+        sensors: whether ticks carry the Spark V's sensor readings (line, IR, encoders,
+            battery, bearings); without them a tick is poses (and speeds) only.
+        bounds_m: ``(x_min, y_min, x_max, y_max)`` of the area to frame (default: the
+            arena's vertices; needed without an arena).
+        name: the recording's name (default: the arena's name and the team size).
 
     Raises :class:`MjswarmError` (one line) if the file cannot be created or a
     parameter is impossible. Use as a context manager or call :meth:`close`.
@@ -207,6 +213,9 @@ class Recorder:
         chunk_ticks: int = CHUNK_TICKS,
         trail_window_s: float = TRAIL_WINDOW_S,
         radio: bool = False,
+        sensors: bool = True,
+        bounds_m: tuple[float, float, float, float] | None = None,
+        name: str | None = None,
     ) -> None:
         if int(n_robots) != n_robots or n_robots < 1:
             raise MjswarmError(f"a recording needs at least 1 robot, got {n_robots}")
@@ -216,7 +225,13 @@ class Recorder:
             raise MjswarmError(f"chunk_ticks must be a whole number >= 1, got {chunk_ticks}")
         if not trail_window_s > 0.0:
             raise MjswarmError(f"trail window must be > 0 s, got {trail_window_s}")
+        if arena is None and bounds_m is None:
+            raise MjswarmError("a recording without an arena needs the bounds of its area")
+        if bounds_m is None:
+            xy = np.array(list(arena.vertices.values()))
+            bounds_m = (*xy.min(axis=0), *xy.max(axis=0))
         self.path = Path(path)
+        self.sensors = sensors
         self.n_robots = n = int(n_robots)
         self._chunk = int(chunk_ticks)
         if self.path.is_dir():
@@ -232,8 +247,8 @@ class Recorder:
             raise MjswarmError(f"cannot write recording {self.path}: {one_line(exc)}") from None
         self._stream.set_log_tick_enabled(False)
         self._stream.set_log_time_enabled(False)
-        self._stream.send_recording_name(f"{arena.name}, {n} robots")
-        self._stream.send_blueprint(_blueprint(arena, n, trail_window_s, radio))
+        self._stream.send_recording_name(name or f"{arena.name}, {n} robots")
+        self._stream.send_blueprint(_blueprint(bounds_m, n, trail_window_s, radio, sensors))
         self._closed = False
 
         b = self._chunk
@@ -253,14 +268,41 @@ class Recorder:
         self._trail_from: np.ndarray | None = None  # (n, 2): last position already sent
         self._latest_xy: np.ndarray | None = None  # (n, 2): last position logged
         self._last_map: dict[int, tuple] = {}
+        self._state: dict[tuple[int, str], tuple[list[int], list[float]]] = {}
 
         self._log_static(arena, float(robot_radius_m))
 
     # --- static data -------------------------------------------------------------------
 
-    def _log_static(self, arena: ArenaSpec, radius_m: float) -> None:
+    def _log_static(self, arena: ArenaSpec | None, radius_m: float) -> None:
         log = self._stream.log
         log("/", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+        if arena is not None:
+            self._log_arena(arena)
+        for i in range(self.n_robots):
+            color = robot_color(i)
+            log(f"robots/{robot_name(i)}/pose", rr.Cylinders3D(
+                lengths=ROBOT_HEIGHT_M, radii=radius_m, centers=(0.0, 0.0, ROBOT_HEIGHT_M / 2),
+                colors=color, labels=robot_name(i), fill_mode="solid",
+            ), static=True)
+            log(f"robots/{robot_name(i)}/pose/heading", rr.Arrows3D(
+                origins=(0.0, 0.0, ROBOT_HEIGHT_M + 0.005), vectors=(1.5 * radius_m, 0.0, 0.0),
+                colors=(255, 255, 255, 255), radii=0.006,
+            ), static=True)
+            name = robot_name(i)
+            log(f"robots/{name}/trail", rr.LineStrips3D.from_fields(colors=color, radii=0.004),
+                static=True)  # style only: static strips would hide the temporal ones
+            log(f"robots/{name}/speed", rr.SeriesLines(names=name, colors=color), static=True)
+            if not self.sensors:
+                continue
+            log(f"robots/{name}/battery", rr.SeriesLines(names=name, colors=color), static=True)
+            for kind, names in (("line", LINE_SENSORS), ("ir", IR_SENSORS),
+                                ("encoders", ENCODERS)):
+                log(f"robots/{name}/sensors/{kind}",
+                    rr.SeriesLines(names=[f"{name} {s}" for s in names]), static=True)
+
+    def _log_arena(self, arena: ArenaSpec) -> None:
+        log = self._stream.log
         strips, walls = arena_primitives(arena)
         if strips:
             c, h, q = _segment_boxes(strips, strips[0].width_m, strips[0].thickness_m, 0.0)
@@ -276,25 +318,6 @@ class Recorder:
             labels=ids, radii=0.015, show_labels=True,
             colors=[_ROOT_COLOR if v == arena.root else _VERTEX_COLOR for v in ids],
         ), static=True)
-        for i in range(self.n_robots):
-            color = robot_color(i)
-            log(f"robots/{robot_name(i)}/pose", rr.Cylinders3D(
-                lengths=ROBOT_HEIGHT_M, radii=radius_m, centers=(0.0, 0.0, ROBOT_HEIGHT_M / 2),
-                colors=color, labels=robot_name(i), fill_mode="solid",
-            ), static=True)
-            log(f"robots/{robot_name(i)}/pose/heading", rr.Arrows3D(
-                origins=(0.0, 0.0, ROBOT_HEIGHT_M + 0.005), vectors=(1.5 * radius_m, 0.0, 0.0),
-                colors=(255, 255, 255, 255), radii=0.006,
-            ), static=True)
-            name = robot_name(i)
-            log(f"robots/{name}/trail", rr.LineStrips3D.from_fields(colors=color, radii=0.004),
-                static=True)  # style only: static strips would hide the temporal ones
-            log(f"robots/{name}/speed", rr.SeriesLines(names=name, colors=color), static=True)
-            log(f"robots/{name}/battery", rr.SeriesLines(names=name, colors=color), static=True)
-            for kind, names in (("line", LINE_SENSORS), ("ir", IR_SENSORS),
-                                ("encoders", ENCODERS)):
-                log(f"robots/{name}/sensors/{kind}",
-                    rr.SeriesLines(names=[f"{name} {s}" for s in names]), static=True)
 
     # --- per tick ----------------------------------------------------------------------
 
@@ -303,12 +326,13 @@ class Recorder:
         step: int,
         sim_time_s: float,
         poses: np.ndarray,
-        line: np.ndarray,
-        ir: np.ndarray,
-        speed: np.ndarray,
-        bearings: Sequence[Sequence[tuple[int, float]]],
-        encoders: np.ndarray,
-        battery: np.ndarray,
+        line: np.ndarray | None = None,
+        ir: np.ndarray | None = None,
+        speed: np.ndarray | None = None,
+        bearings: Sequence[Sequence[tuple[int, float]]] | None = None,
+        encoders: np.ndarray | None = None,
+        battery: np.ndarray | None = None,
+        state: Mapping[int, Mapping[str, float]] | None = None,
     ) -> None:
         """Buffer one control tick; sends a chunk every ``chunk_ticks`` ticks.
 
@@ -318,30 +342,49 @@ class Recorder:
             poses: (N, 3) x (m), y (m), yaw (rad) per robot.
             line: (N, 3) line rangefinder readings (m), order of ``robot.LINE_SENSORS``.
             ir: (N, 3) IR distances (m), NaN = nothing, order of ``robot.IR_SENSORS``.
-            speed: (N,) commanded linear speed (m/s).
+            speed: (N,) commanded linear speed (m/s); None: not logged (zeros).
             bearings: per robot, the (other robot, bearing in rad) pairs it sees.
             encoders: (N, 2) wheel angles (rad), left and right.
             battery: (N,) battery terminal voltage (V).
+            state: per robot index, named numbers describing its controller's state
+                (one series per name, ``robots/R<k>/state/<name>``).
+
+        The sensor readings (line, IR, bearings, encoders, battery) are required when the
+        recorder was made with ``sensors=True`` and refused otherwise.
         """
         self._check_open()
         n = self.n_robots
-        for name, value, shape in (("poses", poses, (n, 3)), ("line", line, (n, 3)),
-                                   ("ir", ir, (n, 3)), ("speed", speed, (n,)),
-                                   ("encoders", encoders, (n, 2)), ("battery", battery, (n,))):
+        readings = (line, ir, bearings, encoders, battery)
+        if self.sensors and any(r is None for r in readings):
+            raise ValueError("log_tick: this recording needs every sensor reading")
+        if not self.sensors and any(r is not None for r in readings):
+            raise ValueError("log_tick: this recording was made without sensors")
+        speed = np.zeros(n) if speed is None else speed
+        checks = [("poses", poses, (n, 3)), ("speed", speed, (n,))]
+        if self.sensors:
+            checks += [("line", line, (n, 3)), ("ir", ir, (n, 3)),
+                       ("encoders", encoders, (n, 2)), ("battery", battery, (n,))]
+            if len(bearings) != n:
+                raise ValueError(f"log_tick: bearings has {len(bearings)} entries, expected {n}")
+        for name, value, shape in checks:
             if np.shape(value) != shape:
                 raise ValueError(f"log_tick: {name} has shape {np.shape(value)}, expected {shape}")
-        if len(bearings) != n:
-            raise ValueError(f"log_tick: bearings has {len(bearings)} entries, expected {n}")
         k = self._rows
         self._steps[k] = step
         self._times[k] = sim_time_s
         self._poses[k] = poses
-        self._line[k] = line
-        self._ir[k] = ir
         self._speed[k] = speed
-        self._encoders[k] = encoders
-        self._battery[k] = battery
-        for i, seen in enumerate(bearings):
+        if self.sensors:
+            self._line[k] = line
+            self._ir[k] = ir
+            self._encoders[k] = encoders
+            self._battery[k] = battery
+        for i, values in (state or {}).items():
+            for name, value in values.items():
+                rows, series = self._state.setdefault((i, name), ([], []))
+                rows.append(k)
+                series.append(float(value))
+        for i, seen in enumerate(bearings or ()):
             for j, bearing in seen:
                 self._bearing_rows.append(k)
                 self._bearing_pairs.append(i * n + j)
@@ -376,14 +419,30 @@ class Recorder:
                 translation=translation[:, i], quaternion=quaternion[:, i]))
             send(f"{robot}/trail", index, rr.LineStrips3D.columns(strips=trail[:, i]))
             send(f"{robot}/speed", index, rr.Scalars.columns(scalars=speed[:, i]))
+            if not self.sensors:
+                continue
             send(f"{robot}/battery", index, rr.Scalars.columns(scalars=battery[:, i]))
             send(f"{robot}/sensors/line", index, rr.Scalars.columns(scalars=line[:, i]))
             send(f"{robot}/sensors/ir", index, rr.Scalars.columns(scalars=ir[:, i]))
             send(f"{robot}/sensors/encoders", index,
                  rr.Scalars.columns(scalars=encoders[:, i]))
         self._send_bearings(steps, times)
+        self._send_state(steps, times)
         self._trail_from = self._latest_xy = xy[-1]
         self._rows = 0
+
+    def _send_state(self, steps: np.ndarray, times: np.ndarray) -> None:
+        for (robot, name), (rows, values) in self._state.items():
+            if not rows:
+                continue
+            r = np.asarray(rows)
+            entity = f"robots/{robot_name(robot)}/state/{rr.escape_entity_path_part(name)}"
+            self._stream.send_columns(
+                entity, [rr.TimeColumn("step", sequence=steps[r]),
+                         rr.TimeColumn("sim_time", duration=times[r])],
+                rr.Scalars.columns(scalars=np.asarray(values)))
+            rows.clear()
+            values.clear()
 
     def _send_bearings(self, steps: np.ndarray, times: np.ndarray) -> None:
         if not self._bearing_rows:
@@ -538,15 +597,15 @@ class Recorder:
         self.close()
 
 
-def _blueprint(arena: ArenaSpec, n_robots: int, trail_window_s: float,
-               radio: bool) -> rrb.Blueprint:
-    """The layout the file opens with: 3-D arena + event log on the left; explored
-    graphs, beacons (and the radio graph) on the top right; time series on the bottom
-    right."""
+def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
+               trail_window_s: float, radio: bool, sensors: bool) -> rrb.Blueprint:
+    """The layout the file opens with: 3-D scene + event log on the left; explored
+    graphs, beacons (and the radio graph) on the top right; time series (speeds,
+    controller state, and the sensors when recorded) on the bottom right."""
     robots = [robot_name(i) for i in range(n_robots)]
-    xy = np.array(list(arena.vertices.values()))
-    centre = (xy.min(axis=0) + xy.max(axis=0)) / 2.0
-    extent = float(max(np.ptp(xy, axis=0).max(), 1.0))
+    low, high = np.array(bounds_m[:2], float), np.array(bounds_m[2:], float)
+    centre = (low + high) / 2.0
+    extent = float(max((high - low).max(), 1.0))
     trail_range = rrb.VisibleTimeRanges(rrb.VisibleTimeRange(
         "sim_time",
         start=rrb.TimeRangeBoundary.cursor_relative(seconds=-trail_window_s),
@@ -578,11 +637,12 @@ def _blueprint(arena: ArenaSpec, n_robots: int, trail_window_s: float,
 
     series = rrb.Tabs(
         plot("speed (m/s)", "speed"),
-        plot("line sensors (m)", "sensors/line"),
-        plot("IR (m)", "sensors/ir"),
-        plot("bearings (rad)", "bearings/**"),
-        plot("encoders (rad)", "sensors/encoders"),
-        plot("battery (V)", "battery"),
+        plot("controller state", "state/**"),
+        *([plot("line sensors (m)", "sensors/line"),
+           plot("IR (m)", "sensors/ir"),
+           plot("bearings (rad)", "bearings/**"),
+           plot("encoders (rad)", "sensors/encoders"),
+           plot("battery (V)", "battery")] if sensors else []),
     )
     return rrb.Blueprint(
         rrb.Horizontal(
@@ -594,3 +654,28 @@ def _blueprint(arena: ArenaSpec, n_robots: int, trail_window_s: float,
         rrb.TimePanel(timeline="sim_time"),
         collapse_panels=False,
     )
+
+
+class Recording(LoopFunctions):
+    """Records any run of the one loop (:class:`~mjswarm.loop.Loop`) with ``recorder``:
+    every robot's pose, trail and commanded speed per tick, each controller's
+    :meth:`~algorithms.robot.Controller.telemetry` as time series, and the radio graph
+    every ``radio_every`` ticks when the world has a radio. Robots off the floor are
+    drawn where the world keeps them (the depot). Close the recorder after the run."""
+
+    def __init__(self, recorder: Recorder, radio_every: int = 10) -> None:
+        self.recorder = recorder
+        self.radio_every = radio_every
+
+    def after_step(self, loop: Loop) -> None:
+        world, rec = loop.world, self.recorder
+        step, now = loop.ticks, world.time_s
+        state = {i: c.telemetry() for i, c in loop.controllers.items() if world.present[i]}
+        rec.log_tick(step, now, world.true_poses(), speed=world.commanded_speeds(),
+                     state=state)
+        if world.radio is not None and step % self.radio_every == 0:
+            rec.log_radio(step, now, [tuple(e) for e in world.radio.graph().edges])
+
+    def event(self, loop: Loop, text: str, robot: int | None = None) -> None:
+        """An experiment's event, at the current tick."""
+        self.recorder.log_event(loop.ticks, loop.world.time_s, text, robot)

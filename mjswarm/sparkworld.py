@@ -76,6 +76,9 @@ class SparkWorld(World):
             inbox=inbox, neighbors=neighbors,
             beacon=None if self.beacon_at is None else self.beacon_at(i))
 
+    def commanded_speeds(self) -> np.ndarray:
+        return self._v.copy()
+
     def bearing_readings(self) -> list[dict[int, float]]:
         """What every robot's bearing sensor reported at the last observed state (for
         recordings; empty without a bearing sensor)."""

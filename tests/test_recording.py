@@ -278,3 +278,32 @@ def test_view_with_display_runs_the_rerun_viewer(fig9_recording, monkeypatch):
     assert open_viewer(path) == 0
     (argv,) = calls
     assert argv[-1] == str(path) and os.access(argv[0], os.X_OK)
+
+
+@pytest.mark.parametrize("argv,entities", [
+    (["experiment", "biconnected-coverage", "--cr", "2", "--world", "embodied",
+      "--episodes", "3"],
+     {"/robots/R1/trail", "/robots/R1/state/busy", "/robots/R6/state/known_regions",
+      "/radio/graph", "/radio/links", "/events/R6"}),
+    (["experiment", "patrol", "--world", "point", "--robots", "5", "--steps", "120"],
+     {"/robots/R2/trail", "/robots/R2/state/role", "/robots/R1/state/connections",
+      "/radio/graph", "/radio/links"}),
+])
+def test_coverage_and_patrol_runs_record_and_verify(tmp_path, capsys, argv, entities):
+    """Recording hangs off the one loop: the open-floor experiments record too."""
+    rrd = tmp_path / "run.rrd"
+    assert main([*argv, "--record", str(rrd)]) == 0
+    done = subprocess.run([*rerun_command(), "rrd", "verify", str(rrd)],
+                          check=False, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    paths = {chunk.entity_path for chunk in rr.chunk.RrdReader(rrd).stream()}
+    assert entities <= paths
+    assert not list(tmp_path.glob(".*.part"))  # the temporary file was moved into place
+
+
+def test_an_experiments_bad_recording_path_fails_before_work(tmp_path, capsys):
+    target = tmp_path / "missing" / "run.rrd"
+    code = main(["experiment", "patrol", "--world", "point", "--record", str(target)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "does not exist" in err[0]
+    assert not target.parent.exists()

@@ -138,6 +138,11 @@ class Explorer(Controller):
             v, w = v * factor, w * factor
         return Command(v, w, messages=tuple(out))
 
+    def telemetry(self) -> dict[str, float]:
+        """Its speed (m/s), vertex calls so far, and whether it is stopped for good."""
+        return {"speed_m_s": self.speed_m_s, "vertex_calls": len(self.calls),
+                "halted": float(self.halted is not None)}
+
     # -- events and vertex calls -----------------------------------------------------------
     def _on_events(self, observation: Observation, out: list[Message]) -> None:
         nav = self.nav

@@ -259,6 +259,12 @@ class BiconnectedRobot(Controller):
                                   observation.inbox, observation.neighbors, observation.pose)
         return Command(velocity_m_s=tuple(velocity), messages=tuple(out))
 
+    def telemetry(self) -> dict[str, float]:
+        """Busy (joining or leading a repair), regions it knows, MOVE floods and
+        distributed checks it led."""
+        return {"busy": float(self.busy), "known_regions": len(self.table),
+                "moves_led": self.moves_led, "checks_led": self.checks_led}
+
     def tick(self, now: int, inbox: Iterable[Message], neighbors: Iterable[Hashable],
              pose: Sequence[float]) -> tuple[list[Message], Point]:
         """Handle this tick's messages; answer with messages and a planar velocity (m/s)."""

@@ -236,6 +236,11 @@ class RoleSwitchingRobot(Controller):
                        messages=tuple(Message(payload, to) for to, payload in out),
                        signal=self.role)
 
+    def telemetry(self) -> dict[str, float]:
+        """Its role (0 base station, 1 repeater, 2 local leader, 3 explorer) and the
+        number of robots it is connected to (|A_i|)."""
+        return {"role": list(Role).index(self.role), "connections": len(self.connections)}
+
     def tick(self, now: int, x: np.ndarray, detected: Mapping[Hashable, Detected],
              inbox: list[tuple[Hashable, object]]) -> tuple[np.ndarray, list[tuple]]:
         """One timestep: returns ``(u_i, [(recipient, message), ...])``; ``u_i`` in m/step."""

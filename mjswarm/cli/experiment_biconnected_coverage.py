@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import argparse
 import sys
+from contextlib import nullcontext
 import time
 
 from tqdm import tqdm
 
 from algorithms.maintenance.biconnected import PLACEMENTS
-from mjswarm.cli.output import check_writable, write_json
+from mjswarm.cli.output import atomic_output, check_writable, write_json
 from mjswarm.coverage_experiment import WORLDS, run_coverage
 
 
@@ -41,16 +42,23 @@ def register(subparsers) -> None:
                         help="region diameter D in metres (default 1.0)")
     parser.add_argument("--json", metavar="PATH",
                         help="write the result as JSON to PATH ('-' for stdout only)")
+    parser.add_argument("--record", metavar="FILE.rrd",
+                        help="write a rerun recording of the run: poses and trails, each "
+                             "robot's controller state, the radio graph, events"
+)
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     check_writable(args.json, "JSON")  # before any work, not after it
+    check_writable(args.record, "recording")
     start = time.perf_counter()
-    with tqdm(total=args.episodes, desc="episodes", unit="ep", file=sys.stderr,
-              disable=not sys.stderr.isatty()) as bar:
+    recording = atomic_output(args.record, "recording") if args.record else nullcontext()
+    with recording as temp, tqdm(total=args.episodes, desc="episodes", unit="ep",
+                                 file=sys.stderr, disable=not sys.stderr.isatty()) as bar:
         result = run_coverage(args.cr, args.placement, args.episodes, args.seed, args.world,
-                              args.region_diameter, progress=bar.update)
+                              args.region_diameter, progress=bar.update,
+                              record=temp)
     data = result.to_dict()
     data["wall_time_s"] = round(time.perf_counter() - start, 2)
     if write_json(data, args.json):

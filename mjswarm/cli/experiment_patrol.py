@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import argparse
 import sys
+from contextlib import nullcontext
 
 from tqdm import tqdm
 
-from mjswarm.cli.output import check_writable, write_json
+from mjswarm.cli.output import atomic_output, check_writable, write_json
 from mjswarm.errors import MjswarmError
 from mjswarm.patrol_experiment import STEP_S, WORLDS, run_patrol
 
@@ -43,17 +44,26 @@ def register(subparsers) -> None:
                              "baseline")
     parser.add_argument("--json", metavar="PATH",
                         help="write the result as JSON to PATH ('-' for stdout only)")
+    parser.add_argument("--record", metavar="FILE.rrd",
+                        help="write a rerun recording of the run: poses and trails, each "
+                             "robot's controller state, the radio graph, events"
+                             " (one trial only)")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     check_writable(args.json, "JSON")  # before any work, not after it
+    check_writable(args.record, "recording")
     if args.steps < 1:
         raise MjswarmError(f"need at least one step, got {args.steps}")
-    with tqdm(total=args.trials * args.steps, desc="steps", unit="step", file=sys.stderr,
-              disable=not sys.stderr.isatty()) as bar:
+    if args.record and args.trials != 1:
+        raise MjswarmError(f"--record holds one mission; drop --trials {args.trials}")
+    recording = atomic_output(args.record, "recording") if args.record else nullcontext()
+    with recording as temp, tqdm(total=args.trials * args.steps, desc="steps", unit="step",
+                                 file=sys.stderr, disable=not sys.stderr.isatty()) as bar:
         result = run_patrol(args.robots, args.trials, args.seed, args.world, args.steps,
-                            every_step_aat=args.aat == "every-step", progress=bar.update)
+                            every_step_aat=args.aat == "every-step", progress=bar.update,
+                            record=temp)
     if write_json(result, args.json):
         return 0
     alg2, base = result["aat_robots"], result["aat_every_step"]  # robots' AAT, shadow

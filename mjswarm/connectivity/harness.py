@@ -84,6 +84,9 @@ class StaticWorld(World):
     def active(self) -> list[Hashable]:
         return list(self.radio.present)
 
+    def commanded_speeds(self) -> np.ndarray:
+        return np.zeros(self.n)
+
     def observe(self, i: Hashable) -> Observation:
         inbox, neighbors = self._inbox(i)
         return Observation(i, self.time_s, inbox=inbox, neighbors=neighbors)
