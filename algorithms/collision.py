@@ -154,7 +154,7 @@ class CollisionRule:
             self.speed = min(self.initial_speed, self.speed + self.epsilon * self.initial_speed)
 
     def forget_bearings(self) -> None:
-        """Drop the bearing histories (the rule is paused; see mjswarm.embodied)."""
+        """Drop the bearing histories (the rule is paused; see mjswarm.experiments.exploration)."""
         self._history.clear()
 
     def crossed_vertex(self) -> None:

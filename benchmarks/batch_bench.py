@@ -3,7 +3,7 @@
 For one world and R replicate simulations of it, measures physics throughput in
 simulated robot-seconds per wall second (R replicates x N robots x simulated seconds /
 wall seconds) of three ways of stepping, all at the control rate of
-:class:`mjswarm.simulation.Simulation` (k physics steps per 50 Hz tick):
+:class:`mjswarm.core.simulation.Simulation` (k physics steps per 50 Hz tick):
 
 * ``loop`` (a): a Python loop over R ``MjData``, ``mj_step(m, d, nstep=k)`` per tick,
   sensors disabled for every substep, constant controls;
@@ -30,7 +30,7 @@ Replicate r drives every robot forward at ``BENCH_SPEED_M_S * (1 - 0.01 r)`` (th
 is shared: every variant meets the same load, and its best run is its least disturbed);
 building ``MjData``/``Batch`` objects is not timed.
 
-Worlds: ``bench:N`` is :func:`mjswarm.bench.bench_world` with N robots; anything else is
+Worlds: ``bench:N`` is :func:`mjswarm.outputs.bench.bench_world` with N robots; anything else is
 an arena (:func:`mjswarm.arena.load_arena`) with ``arena_robots`` robots placed by
 :func:`vertex_poses`.
 
@@ -66,11 +66,11 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 from mjswarm.arena import ArenaSpec, load_arena
 from mjswarm.arena.builder import arena_world_spec
-from mjswarm.bench import BENCH_SPEED_M_S, bench_world
+from mjswarm.outputs.bench import BENCH_SPEED_M_S, bench_world
 from mjswarm.errors import MjswarmError
-from mjswarm.robot import ACTUATORS, LINE_SENSORS
-from mjswarm.simulation import Simulation
-from mjswarm.world import Pose2D
+from mjswarm.core.robot import ACTUATORS, LINE_SENSORS
+from mjswarm.core.simulation import Simulation
+from mjswarm.core.world import Pose2D
 
 #: Wheel-speed difference commanded per metre of left/right line-reading difference
 #: ((rad/s) / m): a strip under one outer sensor (2 mm shorter reading) gives 2 rad/s.
@@ -84,7 +84,7 @@ def vertex_poses(spec: ArenaSpec, k: int) -> list[Pose2D]:
     """k robots on distinct vertices, spread evenly over the spec's vertex order, each
     facing its vertex's first neighbour in edge order (so it drives along a corridor).
 
-    Chosen instead of :class:`mjswarm.embodied.EmbodiedExploration`'s depot, which parks
+    Chosen instead of :class:`mjswarm.experiments.exploration.EmbodiedExploration`'s depot, which parks
     robots on bare floor outside the arena where they would touch no strip or wall.
     """
     ids = list(spec.vertices)

@@ -20,7 +20,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from mjswarm.arena import load_arena
-from mjswarm.graphworld import GraphWorld
+from mjswarm.worlds.graphworld import GraphWorld
 
 
 def bench(

@@ -30,8 +30,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from mjswarm.bench import BENCH_SPEED_M_S, bench_world
-from mjswarm.robot import DEFAULT_ROBOT_XML
+from mjswarm.outputs.bench import BENCH_SPEED_M_S, bench_world
+from mjswarm.core.robot import DEFAULT_ROBOT_XML
 
 CYLINDER_WHEEL = '<geom type="cylinder" size="0.025 0.006" mass="0.03"'
 ELLIPSOID_WHEEL = '<geom type="ellipsoid" size="0.025 0.025 0.006" mass="0.03"'

@@ -13,8 +13,8 @@ import networkx as nx
 import numpy as np
 
 from algorithms.connectivity.tables import ConnectivityTable, interior
-from mjswarm.connectivity import drive, run_check
-from mjswarm.connectivity.comparison import connected_draw, geometric_range, random_team
+from mjswarm.experiments.connectivity import drive, run_check
+from mjswarm.experiments.connectivity.comparison import connected_draw, geometric_range, random_team
 
 
 def literal(self, p):

@@ -15,7 +15,7 @@ import matplotlib
 matplotlib.use("Agg")  # no display needed
 import matplotlib.pyplot as plt  # noqa: E402
 
-from mjswarm.coverage_experiment import PAPER_COVERAGE, run_coverage  # noqa: E402
+from mjswarm.experiments.coverage import PAPER_COVERAGE, run_coverage  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--episodes", type=int, default=40)

@@ -16,8 +16,8 @@ import argparse
 
 from algorithms.exploration.base import DONE, Strategy, go, match_angle
 from mjswarm.arena import load_arena
-from mjswarm.embodied import EmbodiedConfig, explore_embodied
-from mjswarm.graphworld import explore
+from mjswarm.experiments.exploration import EmbodiedConfig, explore_embodied
+from mjswarm.worlds.graphworld import explore
 
 
 class BeaconDfs(Strategy):

@@ -14,9 +14,9 @@ import math
 import random
 
 from algorithms.robot import Command, Controller, Observation
-from mjswarm.loop import Loop
-from mjswarm.openfloor import EmbodiedFloor, PointWorld, spread
-from mjswarm.recording import Recorder, Recording
+from mjswarm.worlds.loop import Loop
+from mjswarm.worlds.openfloor import EmbodiedFloor, PointWorld, spread
+from mjswarm.outputs.recording import Recorder, Recording
 
 
 class RandomWalk(Controller):

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from mjswarm.simulation import Simulation
-from mjswarm.world import Pose2D, world_spec
+from mjswarm.core.simulation import Simulation
+from mjswarm.core.world import Pose2D, world_spec
 
 
 @pytest.fixture

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mjswarm.arena import load_arena
-from mjswarm.embodied import EmbodiedConfig, EmbodiedResult, explore_embodied
+from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedResult, explore_embodied
 
 ARENAS = {"arena1": (2, 3), "arena2": (3, 5), "fig9": (2, 4), "lattice:4x4": (2, 6)}
 

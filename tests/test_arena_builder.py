@@ -12,8 +12,8 @@ import pytest
 from mjswarm.arena import lane_strips, load_arena, shipped_arenas
 from mjswarm.arena.builder import VERTEX_SITE_PREFIX, arena_world_spec, export_mjcf
 from mjswarm.cli import main
-from mjswarm.simulation import Simulation
-from mjswarm.world import Pose2D
+from mjswarm.core.simulation import Simulation
+from mjswarm.core.world import Pose2D
 
 ARENAS = [*shipped_arenas(), "lattice:4x4", "lattice:10x10"]
 

@@ -6,10 +6,10 @@ from __future__ import annotations
 import rerun as rr
 
 from mjswarm.arena import load_arena
-from mjswarm.awareness import truth
+from mjswarm.experiments.awareness import truth
 from mjswarm.cli import main
-from mjswarm.embodied import EmbodiedConfig, EmbodiedExploration
-from mjswarm.graphworld import make_minds
+from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
+from mjswarm.worlds.graphworld import make_minds
 
 
 def test_tables_follow_the_moving_radio_graph():

@@ -10,8 +10,8 @@ import networkx as nx
 import pytest
 
 from mjswarm.cli import main
-from mjswarm.coverage_experiment import CLEARANCE_M, CoverageRun
-from mjswarm.loop import LoopFunctions
+from mjswarm.experiments.coverage import CLEARANCE_M, CoverageRun
+from mjswarm.worlds.loop import LoopFunctions
 
 
 def truth_graph(run: CoverageRun) -> nx.Graph:

@@ -8,9 +8,9 @@ import subprocess
 
 import pytest
 
-import mjswarm.embodied
+import mjswarm.experiments.exploration
 from mjswarm.cli import main
-from mjswarm.recording import rerun_command
+from mjswarm.outputs.recording import rerun_command
 
 ARENA2 = ["explore", "--arena", "arena2", "--robots", "4"]
 
@@ -35,7 +35,7 @@ def test_a_rejected_run_leaves_an_existing_recording_byte_for_byte(tmp_path, cap
 
 
 def test_an_interrupted_run_keeps_a_valid_partial_recording(tmp_path, capsys, monkeypatch):
-    step = mjswarm.embodied.EmbodiedExploration.step
+    step = mjswarm.experiments.exploration.EmbodiedExploration.step
     calls = {"n": 0}
 
     def interrupt_after_a_while(self):
@@ -44,7 +44,7 @@ def test_an_interrupted_run_keeps_a_valid_partial_recording(tmp_path, capsys, mo
             raise KeyboardInterrupt
         step(self)
 
-    monkeypatch.setattr(mjswarm.embodied.EmbodiedExploration, "step", interrupt_after_a_while)
+    monkeypatch.setattr(mjswarm.experiments.exploration.EmbodiedExploration, "step", interrupt_after_a_while)
     target = tmp_path / "run.rrd"
     target.write_bytes(b"old")
     assert main(["explore", "--arena", "arena1", "--robots", "2", "--record",
@@ -75,7 +75,7 @@ def test_json_to_a_bad_path_fails_before_simulating(tmp_path, capsys, monkeypatc
     def no_simulation(*args, **kwargs):
         raise AssertionError("a simulation was built")
 
-    monkeypatch.setattr(mjswarm.embodied, "Simulation", no_simulation)
+    monkeypatch.setattr(mjswarm.experiments.exploration, "Simulation", no_simulation)
     monkeypatch.chdir(tmp_path)
     assert message in one_line_error(capsys, [*ARENA2, "--json", target])
 

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from algorithms.collision import CollisionRule, epsilons, satisfies_28
-from mjswarm.bearing import BearingSensor
-from mjswarm.simulation import Simulation
-from mjswarm.world import Pose2D, WallSegment, world_spec
+from mjswarm.core.bearing import BearingSensor
+from mjswarm.core.simulation import Simulation
+from mjswarm.core.world import Pose2D, WallSegment, world_spec
 
 S = 0.05
 

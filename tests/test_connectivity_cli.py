@@ -7,7 +7,7 @@ import json
 import pytest
 
 from mjswarm.cli import main
-from mjswarm.connectivity import load_team, parse_team
+from mjswarm.experiments.connectivity import load_team, parse_team
 from mjswarm.errors import MjswarmError
 
 SQUARE = {"positions": {"a": [0, 0], "b": [1, 0], "c": [1, 1], "d": [0, 1], "e": [2, 0.5]}}

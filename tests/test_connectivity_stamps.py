@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from algorithms.connectivity import BiconnectivityCheck, dcr_members, stamp_relay
-from mjswarm.connectivity import Team, drive, run_check
-from mjswarm.connectivity.comparison import geometric_range, random_team, ring_team
+from mjswarm.experiments.connectivity import Team, drive, run_check
+from mjswarm.experiments.connectivity.comparison import geometric_range, random_team, ring_team
 
 
 def edge_team(edges, nodes=()) -> Team:

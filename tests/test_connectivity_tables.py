@@ -15,10 +15,10 @@ import pytest
 
 from algorithms.connectivity import ConnectivityTable, TableCheck, merge_groups
 from algorithms.connectivity.tables import LinkBroken, NewAccessPath, crossed_before
-from mjswarm.connectivity import Team, drive, run_check
-from mjswarm.connectivity.comparison import geometric_range, random_team, ring_team
+from mjswarm.experiments.connectivity import Team, drive, run_check
+from mjswarm.experiments.connectivity.comparison import geometric_range, random_team, ring_team
 from algorithms.robot import Message
-from mjswarm.radio import Radio
+from mjswarm.core.radio import Radio
 
 # -- helpers --------------------------------------------------------------------------
 
@@ -387,7 +387,7 @@ def test_runs_do_not_depend_on_the_hash_seed(tmp_path):
     path.write_text(json.dumps({"positions": {k: list(v) for k, v in team.positions.items()}}))
     script = (
         "import json, sys\n"
-        "from mjswarm.connectivity import load_team, run_check\n"
+        "from mjswarm.experiments.connectivity import load_team, run_check\n"
         "team = load_team(sys.argv[1])\n"
         "print(json.dumps([run_check(team, m, range_m=float(sys.argv[2]), drop_prob=0.1)"
         ".to_dict() for m in ('stamps', 'tables', 'tables-2')]))\n"

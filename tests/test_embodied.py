@@ -12,8 +12,8 @@ from embodied_scenarios import scenarios
 
 from mjswarm.arena import load_arena
 from mjswarm.cli import main
-from mjswarm.embodied import EmbodiedConfig, explore_embodied
-from mjswarm.recording import rerun_command
+from mjswarm.experiments.exploration import EmbodiedConfig, explore_embodied
+from mjswarm.outputs.recording import rerun_command
 
 
 def truth(arena: str) -> list[tuple[str, str]]:

@@ -9,7 +9,7 @@ from exploration_graphs import fig9
 
 from algorithms.exploration import IncidenceDFS
 from algorithms.exploration.incidence_matrix import COMPLETED, OUT, UNEXPLORED
-from mjswarm.graphworld import GraphWorld, explore
+from mjswarm.worlds.graphworld import GraphWorld, explore
 
 PI = math.pi
 

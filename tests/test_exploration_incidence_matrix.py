@@ -27,7 +27,7 @@ from algorithms.exploration.incidence_matrix import (
     IncidenceMatrix,
     merge,
 )
-from mjswarm.graphworld import GraphWorld
+from mjswarm.worlds.graphworld import GraphWorld
 
 
 def random_knowledge(world: GraphWorld, rng: np.random.Generator) -> IncidenceMatrix:

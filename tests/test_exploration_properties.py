@@ -14,7 +14,7 @@ from exploration_graphs import grid_tree, lattice, planar_graph, star
 from algorithms.exploration import STRATEGIES, IncidenceDFS
 from algorithms.exploration.base import Decision, Strategy
 from mjswarm.arena import load_arena
-from mjswarm.graphworld import GraphWorld, explore
+from mjswarm.worlds.graphworld import GraphWorld, explore
 
 ROBOTS = range(1, 9)
 

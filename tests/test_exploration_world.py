@@ -11,7 +11,7 @@ from exploration_graphs import fig9, graph, lattice
 from algorithms.exploration import DONE, IDLE, go
 from algorithms.exploration.base import Strategy
 from mjswarm.errors import MjswarmError
-from mjswarm.graphworld import GraphWorld, explore, make_minds
+from mjswarm.worlds.graphworld import GraphWorld, explore, make_minds
 
 
 class Script(Strategy):

@@ -7,11 +7,11 @@ import json
 import pytest
 
 from mjswarm.arena import load_arena
-from mjswarm.embodied import EmbodiedConfig, EmbodiedExploration, explore_embodied
+from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration, explore_embodied
 from mjswarm.errors import MjswarmError
-from mjswarm.faults import BeaconWipe, RadioBlackout, RobotFailure, parse_fault
-from mjswarm.graphworld import make_minds
-from mjswarm.radio import Radio
+from mjswarm.experiments.faults import BeaconWipe, RadioBlackout, RobotFailure, parse_fault
+from mjswarm.worlds.graphworld import make_minds
+from mjswarm.core.radio import Radio
 
 
 @pytest.mark.parametrize("text,fault", [

@@ -13,11 +13,11 @@ from algorithms.navigation.driving import Navigating
 from algorithms.navigation.navigator import frame_offset
 from mjswarm.arena import incidence_angle, load_arena
 from mjswarm.arena.builder import arena_world_spec
-from mjswarm.loop import Loop
-from mjswarm.navigation import calibration, conventions
-from mjswarm.simulation import Simulation
-from mjswarm.sparkworld import SparkWorld
-from mjswarm.world import Pose2D
+from mjswarm.worlds.loop import Loop
+from mjswarm.worlds.navigation import calibration, conventions
+from mjswarm.core.simulation import Simulation
+from mjswarm.worlds.sparkworld import SparkWorld
+from mjswarm.core.world import Pose2D
 
 
 def random_fan(rng: np.random.Generator) -> list[float]:

@@ -20,11 +20,11 @@ from algorithms.navigation import Navigator, NavigatorState
 from algorithms.navigation.driving import Navigating
 from mjswarm.arena import incidence_angle, lane_strips, load_arena
 from mjswarm.arena.builder import arena_world_spec
-from mjswarm.loop import Loop
-from mjswarm.navigation import calibration, conventions
-from mjswarm.simulation import Simulation
-from mjswarm.sparkworld import SparkWorld
-from mjswarm.world import Pose2D
+from mjswarm.worlds.loop import Loop
+from mjswarm.worlds.navigation import calibration, conventions
+from mjswarm.core.simulation import Simulation
+from mjswarm.worlds.sparkworld import SparkWorld
+from mjswarm.core.world import Pose2D
 
 SPEED_M_S = 0.1
 ARRIVAL_TOLERANCE_M = 0.02

@@ -11,8 +11,8 @@ import pytest
 from algorithms.motion import track_velocity
 from algorithms.robot import Command, Controller, Observation
 from mjswarm.errors import MjswarmError
-from mjswarm.loop import Loop
-from mjswarm.openfloor import EmbodiedFloor, PointWorld, spread
+from mjswarm.worlds.loop import Loop
+from mjswarm.worlds.openfloor import EmbodiedFloor, PointWorld, spread
 
 
 def test_track_velocity_turns_first_and_never_reverses():

@@ -20,7 +20,7 @@ from algorithms.maintenance.roles import (
     State,
 )
 from mjswarm.cli import main
-from mjswarm.patrol_experiment import run_trial
+from mjswarm.experiments.patrol import run_trial
 
 P = RoleParams()
 

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from mjswarm.errors import MjswarmError
-from mjswarm.robot import load_robot_spec
-from mjswarm.simulation import Simulation
-from mjswarm.world import FloorStrip, Pose2D, WallSegment, world_spec
+from mjswarm.core.robot import load_robot_spec
+from mjswarm.core.simulation import Simulation
+from mjswarm.core.world import FloorStrip, Pose2D, WallSegment, world_spec
 
 SETTLE_S = 1.0
 
@@ -147,11 +147,11 @@ def test_wheel_slip_makes_encoders_over_read_and_is_seeded():
 
 def test_scene_xml_loads_with_the_worlds_physics_settings():
     """models/scene.xml (for the viewer) uses the timestep and integrator every world
-    uses (mjswarm.world), and holds one robot."""
+    uses (mjswarm.core.world), and holds one robot."""
     import mujoco
 
-    from mjswarm.robot import MODELS_DIR, spark_v_geometry
-    from mjswarm.world import PHYSICS_TIMESTEP_S
+    from mjswarm.core.robot import MODELS_DIR, spark_v_geometry
+    from mjswarm.core.world import PHYSICS_TIMESTEP_S
 
     model = mujoco.MjModel.from_xml_path(str(MODELS_DIR / "scene.xml"))
     assert model.opt.timestep == PHYSICS_TIMESTEP_S

@@ -1,6 +1,6 @@
 """Grid ray casting equals MuJoCo's: ``mj_ray`` per ray, and plain rangefinders per robot.
 
-The O(N) sensing (:mod:`mjswarm.raycast`, ``Simulation(sensing="grid")``) must give the
+The O(N) sensing (:mod:`mjswarm.core.raycast`, ``Simulation(sensing="grid")``) must give the
 readings MuJoCo's own rangefinders give on the same states, within 1e-9 (issue 8). Random
 states put robots anywhere on an arena with walls and strips, against walls, against and
 inside each other, and some tipped over or upside down (their line sensors miss the floor
@@ -18,12 +18,12 @@ import pytest
 
 from mjswarm.arena import load_arena
 from mjswarm.arena.builder import arena_world_spec
-from mjswarm.bearing import BearingSensor
+from mjswarm.core.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
-from mjswarm.raycast import RayCaster, Rays
-from mjswarm.sight import LineOfSight
-from mjswarm.simulation import GRID_SENSING_MIN_ROBOTS, Simulation
-from mjswarm.world import Pose2D, world_spec
+from mjswarm.core.raycast import RayCaster, Rays
+from mjswarm.core.sight import LineOfSight
+from mjswarm.core.simulation import GRID_SENSING_MIN_ROBOTS, Simulation
+from mjswarm.core.world import Pose2D, world_spec
 
 ROBOTS = 12
 TOLERANCE = 1e-9

@@ -19,7 +19,7 @@ from mjswarm.arena import load_arena
 from mjswarm.arena.builder import arena_primitives
 from mjswarm.cli import main
 from mjswarm.errors import MjswarmError
-from mjswarm.recording import Recorder, has_display, open_viewer, rerun_command
+from mjswarm.outputs.recording import Recorder, has_display, open_viewer, rerun_command
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from algorithms.robot import Command, Controller, Message, Observation
-from mjswarm.bench import bench_world
+from mjswarm.outputs.bench import bench_world
 from mjswarm.errors import MjswarmError
-from mjswarm.loop import Loop, LoopFunctions
-from mjswarm.openfloor import PointWorld
-from mjswarm.radio import Radio
-from mjswarm.sparkworld import SparkWorld
+from mjswarm.worlds.loop import Loop, LoopFunctions
+from mjswarm.worlds.openfloor import PointWorld
+from mjswarm.core.radio import Radio
+from mjswarm.worlds.sparkworld import SparkWorld
 
 #: Everything an observation may hold: the robot's own id and clock, its own sensors,
 #: what its exteroceptive sensors and radio report, the beacon it stands on. A field

@@ -1,4 +1,4 @@
-"""Vertex entry (mjswarm.stations): holds, first-come grants, and no circular wait."""
+"""Vertex entry (mjswarm.experiments.stations): holds, first-come grants, and no circular wait."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mjswarm.arena import load_arena
-from mjswarm.stations import VertexStations
+from mjswarm.experiments.stations import VertexStations
 
 
 @pytest.fixture

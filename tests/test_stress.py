@@ -1,11 +1,11 @@
-"""Issue 13's robustness stress grid (mjswarm.stress): a fast representative of each
+"""Issue 13's robustness stress grid (mjswarm.experiments.stress): a fast representative of each
 failure class by default, the whole grid with ``-m slow``."""
 
 from __future__ import annotations
 
 import pytest
 
-from mjswarm.stress import StressRun, grid, passed, run_grid, table
+from mjswarm.experiments.stress import StressRun, grid, passed, run_grid, table
 
 
 @pytest.mark.parametrize("run", [

@@ -9,8 +9,8 @@ import pytest
 from mjswarm.arena import load_arena
 from mjswarm.cli import main
 from mjswarm.errors import MjswarmError
-from mjswarm.graphworld import GraphWorld
-from mjswarm.sweep import Cell, ResultsFile, grid, run_cell, sweep
+from mjswarm.worlds.graphworld import GraphWorld
+from mjswarm.outputs.sweep import Cell, ResultsFile, grid, run_cell, sweep
 
 ARGS = ["sweep", "--arenas", "fig9,tree1", "--robots", "2-3", "--strategies",
         "incidence-dfs,mr-dfs", "--seeds", "0,1"]

@@ -2,7 +2,7 @@
 
 Seed 003 emulated beacons with a central station over XBee that kept "separate
 information for each vertex"; ours also decides who may enter which vertex area (one
-robot per area, :mod:`mjswarm.stations` explains why no circular wait forms). Robots
+robot per area, :mod:`mjswarm.experiments.stations` explains why no circular wait forms). Robots
 reach the stations from anywhere (the station's XBee link), one control tick each way,
 and every message is counted with the radio's. The protocol, from the robot's side:
 

@@ -12,7 +12,7 @@ It composes, fed only by its own observation:
 * optionally a :class:`~algorithms.connectivity.ConnectivityTable` (seed 004) kept over
   its radio: its belief whether a single robot's loss would cut it off the reference.
 
-Choices beyond the paper (the loop functions in :mod:`mjswarm.embodied` say the rest):
+Choices beyond the paper (the loop functions in :mod:`mjswarm.experiments.exploration` say the rest):
 
 * **The speed rule applies on edges** (following a lane, seed 003 Sec. 4 "traversing an
   edge"); in the vertex area robots move at S and are kept apart by vertex entry. A robot

@@ -2,11 +2,11 @@
 
 Each robot is responsible for a circular region and holds at its centre. Two robots are
 neighbours when their centres are at most ``link_m`` apart (the experiment runner derives
-``link_m`` from cr; see :mod:`mjswarm.coverage_experiment`). One :class:`BiconnectedRobot`
+``link_m`` from cr; see :mod:`mjswarm.experiments.coverage`). One :class:`BiconnectedRobot`
 per robot, driven once per control tick like the connectivity minds
 (``tick(now, inbox, neighbors, pose) -> (messages, planar velocity)``).
 
-Messages (one-hop broadcasts through :class:`mjswarm.radio.Radio` unless said otherwise):
+Messages (one-hop broadcasts through :class:`mjswarm.core.radio.Radio` unless said otherwise):
 
 * ``Region(robot, centre)``: a robot's region centre; flooded (relayed once per new value).
   Every robot keeps a table of the centres (the paper's "approximation of other robots'

@@ -1,6 +1,6 @@
 """Sensor-only navigation on line-marked arenas (seed 003, Sec. 5).
 
-Pure Python: the embodied adapter (:mod:`mjswarm.embodied`) feeds each robot's own
+Pure Python: the embodied adapter (:mod:`mjswarm.experiments.exploration`) feeds each robot's own
 readings (line sensors, IR, wheel encoders) in, and applies the ``(v, omega)`` that comes
 out. Nothing here knows the arena graph or any ground truth.
 """

@@ -1,7 +1,7 @@
 """Arena spec -> MuJoCo world (issue 3, part 2).
 
 Turns the geometry of :mod:`mjswarm.arena.geometry` (lane strips, vertex spokes,
-corridor walls) into floor strips and walls for :func:`mjswarm.world.world_spec`, adds a
+corridor walls) into floor strips and walls for :func:`mjswarm.core.world.world_spec`, adds a
 named site ``vertex:<id>`` at every vertex centre (for recordings and tests; robots never
 read sites), and places robots. This is the only module of :mod:`mjswarm.arena` that
 imports MuJoCo.
@@ -24,8 +24,8 @@ from mjswarm.arena.geometry import (
 )
 from mjswarm.arena.spec import ArenaSpec
 from mjswarm.errors import MjswarmError, one_line
-from mjswarm.robot import DEFAULT_ROBOT_XML
-from mjswarm.world import FloorStrip, Pose2D, WallSegment, world_spec
+from mjswarm.core.robot import DEFAULT_ROBOT_XML
+from mjswarm.core.world import FloorStrip, Pose2D, WallSegment, world_spec
 
 VERTEX_SITE_PREFIX = "vertex:"
 

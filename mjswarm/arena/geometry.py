@@ -71,7 +71,7 @@ SPOKE_RADIUS_M = 0.12
 SPOKE_INNER_RADIUS_M = 0.03
 #: Walls start at least this far (along the edge) from each vertex centre (m). A robot
 #: detects a vertex where its left wall ends and, if another robot is on the vertex, waits
-#: there (mjswarm.embodied, vertex entry): its centre is then 0.26 m from the vertex centre
+#: there (mjswarm.experiments.exploration, vertex entry): its centre is then 0.26 m from the vertex centre
 #: and 0.17 m from the lane of a robot leaving on the neighbouring edge 90 degrees away,
 #: more than the 0.15 m two robot bodies need.
 VERTEX_CLEAR_RADIUS_M = 0.255

@@ -47,8 +47,8 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
-    from mjswarm.bench import as_dict, run_bench
-    from mjswarm.robot import DEFAULT_ROBOT_XML, load_robot_spec
+    from mjswarm.outputs.bench import as_dict, run_bench
+    from mjswarm.core.robot import DEFAULT_ROBOT_XML, load_robot_spec
 
     counts = _counts(args.robots)
     model = args.model or str(DEFAULT_ROBOT_XML)

@@ -9,7 +9,7 @@ from dataclasses import asdict
 from tqdm import tqdm
 
 from mjswarm.cli.output import check_writable, write_json
-from mjswarm.connectivity.comparison import (
+from mjswarm.experiments.connectivity.comparison import (
     FAMILIES,
     compare_messages,
     markdown_table,

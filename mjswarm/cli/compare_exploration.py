@@ -1,5 +1,5 @@
 """``mjswarm compare exploration``: seed 003's Fig. 8, Fig. 17 and 4 x 4 lattice comparisons
-(:mod:`mjswarm.exploration_compare`)."""
+(:mod:`mjswarm.experiments.exploration_compare`)."""
 
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
-    from mjswarm.exploration_compare import run_comparison, write_report
+    from mjswarm.experiments.exploration_compare import run_comparison, write_report
 
     if args.seeds < 0:
         raise MjswarmError(f"--seeds must be >= 0, got {args.seeds}")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from mjswarm.cli.output import check_writable, write_json
-from mjswarm.connectivity import DEFAULT_MESSAGE_CAP, METHODS, load_team, run_check
+from mjswarm.experiments.connectivity import DEFAULT_MESSAGE_CAP, METHODS, load_team, run_check
 
 
 def register(subparsers) -> None:

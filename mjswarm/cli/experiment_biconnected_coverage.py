@@ -11,7 +11,7 @@ from tqdm import tqdm
 
 from algorithms.maintenance.biconnected import PLACEMENTS
 from mjswarm.cli.output import atomic_output, check_writable, write_json
-from mjswarm.coverage_experiment import WORLDS, run_coverage
+from mjswarm.experiments.coverage import WORLDS, run_coverage
 
 
 def register(subparsers) -> None:

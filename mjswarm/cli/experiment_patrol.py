@@ -10,7 +10,7 @@ from tqdm import tqdm
 
 from mjswarm.cli.output import atomic_output, check_writable, write_json
 from mjswarm.errors import MjswarmError
-from mjswarm.patrol_experiment import STEP_S, WORLDS, run_patrol
+from mjswarm.experiments.patrol import STEP_S, WORLDS, run_patrol
 
 
 def register(subparsers) -> None:

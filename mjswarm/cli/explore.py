@@ -1,7 +1,7 @@
 """``mjswarm explore``: run one exploration and report seed 003's metrics.
 
-Worlds: ``embodied`` (MuJoCo robots with their own sensors, :mod:`mjswarm.embodied`; the
-default) and ``graph`` (the fast abstract graph world, :mod:`mjswarm.graphworld`). Each
+Worlds: ``embodied`` (MuJoCo robots with their own sensors, :mod:`mjswarm.experiments.exploration`; the
+default) and ``graph`` (the fast abstract graph world, :mod:`mjswarm.worlds.graphworld`). Each
 world is a function ``run_<world>(args) -> dict`` registered in :data:`WORLDS`.
 """
 
@@ -11,8 +11,8 @@ from algorithms.collision import PAPER_SPEED_M_S
 from algorithms.exploration import STRATEGIES
 from mjswarm.cli.output import atomic_output, check_writable, write_json
 from mjswarm.errors import MjswarmError
-from mjswarm.graphworld import EDGE_TIMES, GraphWorld
-from mjswarm.robot import spark_v_geometry
+from mjswarm.worlds.graphworld import EDGE_TIMES, GraphWorld
+from mjswarm.core.robot import spark_v_geometry
 
 
 def run_graph(args) -> dict:
@@ -34,10 +34,10 @@ def run_embodied(args) -> dict:
     recording goes to a temporary file that replaces ``--record`` when the run ends
     (:func:`mjswarm.cli.output.atomic_output`)."""
     from mjswarm.arena import ArenaSpec, load_arena
-    from mjswarm.embodied import EmbodiedConfig, EmbodiedExploration
-    from mjswarm.faults import parse_fault
-    from mjswarm.graphworld import make_minds
-    from mjswarm.recording import Recorder
+    from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
+    from mjswarm.experiments.faults import parse_fault
+    from mjswarm.worlds.graphworld import make_minds
+    from mjswarm.outputs.recording import Recorder
 
     spec = load_arena(args.arena)
     if args.root and args.root != spec.root:

@@ -59,7 +59,7 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
-    from mjswarm.sweep import ResultsFile, grid, sweep
+    from mjswarm.outputs.sweep import ResultsFile, grid, sweep
 
     cells = grid(args.world, [a for a in args.arenas.split(",") if a],
                  _ints(args.robots, "--robots"), [s for s in args.strategies.split(",") if s],

@@ -16,7 +16,7 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
-    """``mjswarm view``: :func:`mjswarm.recording.open_viewer` on FILE."""
-    from mjswarm.recording import open_viewer
+    """``mjswarm view``: :func:`mjswarm.outputs.recording.open_viewer` on FILE."""
+    from mjswarm.outputs.recording import open_viewer
 
     return open_viewer(args.file)

@@ -1,7 +1,7 @@
 """The stepping loop: physics at ~2 ms, sensing and control at a lower rate.
 
 :class:`Simulation` owns one compiled world of N robots (built by
-:func:`mjswarm.world.world_spec`). Each control tick it
+:func:`mjswarm.core.world.world_spec`). Each control tick it
 
 1. writes the wheel-speed commands (rad/s) into ``data.ctrl``,
 2. advances physics ``substeps`` steps with ``mj_step(..., nstep=k)``; sensors are read
@@ -16,7 +16,7 @@ costs less than the grid's fixed per-tick cost, and ``"grid"`` from there on):
 
 * ``"grid"``, O(N): MuJoCo's sensor stage stays disabled; the rangefinders
   declared in the robot model (site, direction = site z axis, ``cutoff``) are cast by
-  :class:`mjswarm.raycast.RayCaster` against nearby geoms only, and encoders and wheel
+  :class:`mjswarm.core.raycast.RayCaster` against nearby geoms only, and encoders and wheel
   speeds are the wheel joints' ``qpos`` / ``qvel``, which is what MuJoCo's ``jointpos`` /
   ``jointvel`` sensors return. A rangefinder without a cutoff is probed over
   ``UNBOUNDED_PROBE_M`` and, if nothing is there (a tipped robot), re-cast with ``mj_ray``.
@@ -35,11 +35,11 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from mjswarm.battery import Battery
-from mjswarm.contacts import CollisionCounter
+from mjswarm.core.battery import Battery
+from mjswarm.core.contacts import CollisionCounter
 from mjswarm.errors import MjswarmError, one_line
-from mjswarm.raycast import RayCaster, Rays
-from mjswarm.robot import (
+from mjswarm.core.raycast import RayCaster, Rays
+from mjswarm.core.robot import (
     ACTUATORS,
     ENCODERS,
     IR_SENSORS,
@@ -48,8 +48,8 @@ from mjswarm.robot import (
     WHEEL_SPEED_SENSORS,
     measure_geometry,
 )
-from mjswarm.sight import LineOfSight
-from mjswarm.world import Pose2D, yaw_quat
+from mjswarm.core.sight import LineOfSight
+from mjswarm.core.world import Pose2D, yaw_quat
 
 #: One robot's sensor record: line rangefinders (m), IR distances (m, NaN = nothing
 #: within range), wheel encoders (rad), wheel speeds (rad/s), battery voltage (V).
@@ -76,7 +76,7 @@ class Simulation:
     """N robots stepping together.
 
     Args:
-        spec: an uncompiled world from :func:`mjswarm.world.world_spec` (robots ``r0``...).
+        spec: an uncompiled world from :func:`mjswarm.core.world.world_spec` (robots ``r0``...).
         control_hz: control / sensing rate (Hz); must divide the physics rate.
         seed: seeds the sensor noise generator.
         line_noise_m, ir_noise_m: standard deviation of Gaussian noise added to the line
@@ -184,7 +184,7 @@ class Simulation:
 
     @property
     def sight(self) -> LineOfSight:
-        """Robot-to-robot line of sight, cast once per state (:mod:`mjswarm.sight`)."""
+        """Robot-to-robot line of sight, cast once per state (:mod:`mjswarm.core.sight`)."""
         if self._sight is None:
             self._sight = LineOfSight(self)
         return self._sight

@@ -27,8 +27,8 @@ from pathlib import Path
 import networkx as nx
 import numpy as np
 
-from mjswarm.connectivity.harness import METHODS, CheckResult, run_check
-from mjswarm.connectivity.team import Team
+from mjswarm.experiments.connectivity.harness import METHODS, CheckResult, run_check
+from mjswarm.experiments.connectivity.team import Team
 from mjswarm.errors import MjswarmError
 
 FAMILIES: tuple[str, ...] = ("geometric", "ring", "complete")

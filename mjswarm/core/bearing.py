@@ -3,7 +3,7 @@
 Modelled on an omnidirectional IR beacon receiver with robot identification (each
 robot's beacon is modulated with its id): robot ``k`` sees robot ``p`` when ``p`` is within
 ``range_m`` and inside the field of view ``|beta| <= fov_rad`` around ``k``'s heading, and
-nothing blocks the line of sight (:mod:`mjswarm.sight`: a ray from ``k``'s centre towards
+nothing blocks the line of sight (:mod:`mjswarm.core.sight`: a ray from ``k``'s centre towards
 ``p`` hits ``p`` first; only collision geoms, group 0, block: walls and robots).
 The reading is ``beta_kp``: the angle from ``k``'s heading to ``p`` (rad, CCW positive),
 plus optional Gaussian noise. Defaults: +-60 degrees, 1 m.
@@ -11,7 +11,7 @@ plus optional Gaussian noise. Defaults: +-60 degrees, 1 m.
 Sampled at the control rate from the simulated world; controllers receive only
 ``{p: beta_kp}``. O(N) for bounded density: candidate pairs come from a k-d tree of the
 robots' positions (``cKDTree.query_pairs``), and line of sight is the simulation's
-:attr:`~mjswarm.simulation.Simulation.sight`, cast once per state and shared with the radio.
+:attr:`~mjswarm.core.simulation.Simulation.sight`, cast once per state and shared with the radio.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from mjswarm.simulation import Simulation
+from mjswarm.core.simulation import Simulation
 
 DEFAULT_FOV_RAD = math.radians(60.0)
 DEFAULT_RANGE_M = 1.0

@@ -51,11 +51,11 @@ import numpy as np
 from algorithms.maintenance.biconnected import PLACEMENTS, BiconnectedRobot, Params
 from algorithms.maintenance.regions import union_area
 from mjswarm.errors import MjswarmError
-from mjswarm.loop import Loop, LoopFunctions
-from mjswarm.openfloor import EmbodiedFloor, MotionWorld, PointWorld
-from mjswarm.robot import spark_v_geometry
-from mjswarm.radio import Radio
-from mjswarm.recording import Recorder, Recording
+from mjswarm.worlds.loop import Loop, LoopFunctions
+from mjswarm.worlds.openfloor import EmbodiedFloor, MotionWorld, PointWorld
+from mjswarm.core.robot import spark_v_geometry
+from mjswarm.core.radio import Radio
+from mjswarm.outputs.recording import Recorder, Recording
 
 MAX_ROBOTS = 10
 START_ROBOTS = 5
@@ -113,7 +113,7 @@ class CoverageResult:
 class CoverageRun(LoopFunctions):
     """The experiment's loop functions: world, radio, robots, episodes.
 
-    One :class:`~mjswarm.loop.Loop` runs the :class:`BiconnectedRobot` controllers; this
+    One :class:`~mjswarm.worlds.loop.Loop` runs the :class:`BiconnectedRobot` controllers; this
     object adds and removes robots between episodes and stops the loop when an episode
     has settled.
 
@@ -125,7 +125,7 @@ class CoverageRun(LoopFunctions):
         region_diameter_m: D, the diameter of every region (m).
         max_ticks: an episode that has not settled by then raises :class:`MjswarmError`.
         clearance_m: distance robots keep (m); default ``CLEARANCE_M`` embodied, 0 points.
-        recorder: a :class:`~mjswarm.recording.Recorder` for ``MAX_ROBOTS`` robots without
+        recorder: a :class:`~mjswarm.outputs.recording.Recorder` for ``MAX_ROBOTS`` robots without
             sensors (:func:`recorder_for`), or None.
     """
 

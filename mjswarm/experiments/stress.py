@@ -4,7 +4,7 @@ Arenas with vertices whose edges are 45-90 degrees apart, at arbitrary rotations
 wheels, hexagonal and triangular lattices, random planar graphs, rotated lattices and
 paper arenas), 1 to 10 robots, speeds from the paper's 0.05 m/s to the top speed 0.2
 m/s, several seeds. Every run must complete with the true map, no robot stopped and no
-robot-robot contact. ``python -m mjswarm.stress`` runs the grid on a process pool and
+robot-robot contact. ``python -m mjswarm.experiments.stress`` runs the grid on a process pool and
 prints its table (the one in README); ``tests/test_stress.py`` runs a fast
 representative of each failure class by default and the whole grid with ``-m slow``.
 """
@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from tqdm import tqdm
 
 from mjswarm.arena import ArenaSpec, load_arena, parse_arena_spec
-from mjswarm.embodied import EmbodiedConfig, EmbodiedResult, explore_embodied
+from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedResult, explore_embodied
 
 #: Issue 13's first report: one robot arriving at v1, whose edges are 67.5 degrees
 #: apart, was carried out along a neighbouring spoke.
@@ -110,7 +110,7 @@ def table(rows: list[tuple[StressRun, EmbodiedResult, float]]) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m mjswarm.stress",
+        prog="python -m mjswarm.experiments.stress",
         description="Run issue 13's robustness stress grid and print its table (markdown); "
                     "exit status 1 if any run failed (the failures are listed).")
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1,

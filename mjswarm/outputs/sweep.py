@@ -75,12 +75,12 @@ def run_cell(cell: Cell) -> dict:
 
     spec = load_arena(cell.arena)
     if cell.world == "graph":
-        from mjswarm.graphworld import GraphWorld
+        from mjswarm.worlds.graphworld import GraphWorld
 
         result = GraphWorld(spec.graph(), spec.root).explore(
             cell.robots, cell.strategy, seed=cell.seed, arena=spec.name)
     else:
-        from mjswarm.embodied import explore_embodied
+        from mjswarm.experiments.exploration import explore_embodied
 
         result = explore_embodied(spec, cell.robots, cell.strategy, seed=cell.seed)
     record = result.to_dict()

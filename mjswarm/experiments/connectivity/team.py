@@ -23,7 +23,7 @@ from typing import Any
 import networkx as nx
 
 from mjswarm.errors import MjswarmError
-from mjswarm.radio import Radio, walls_blocker
+from mjswarm.core.radio import Radio, walls_blocker
 
 Point = tuple[float, float]
 _KEYS = {"positions", "edges", "walls", "name", "description"}

@@ -16,7 +16,7 @@ import mujoco
 
 from mjswarm.errors import MjswarmError, one_line
 
-MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
+MODELS_DIR = Path(__file__).resolve().parents[2] / "models"
 DEFAULT_ROBOT_XML = MODELS_DIR / "spark_v.xml"
 
 #: The root body every robot model must name (an unnamed root silently drops

@@ -6,7 +6,7 @@ robot is heard by every robot within range d_c of it, and it arrives within one 
 which here is exactly one control tick. On top of that the radio can drop each copy of a
 message with probability ``drop_prob`` (seeded numpy Generator) and can block a link when
 line of sight is lost (an injected, vectorised :data:`Blocker`: the embodied world passes
-:func:`mjswarm.awareness.sight_blocker`, the static harness :func:`walls_blocker`). Per-robot counters give the
+:func:`mjswarm.experiments.awareness.sight_blocker`, the static harness :func:`walls_blocker`). Per-robot counters give the
 papers' message complexities.
 
 One control tick, as the world or the harness drives it::
@@ -340,7 +340,7 @@ def walls_blocker(
     positions of robots i and j (read from ``positions`` at call time, metres, x and y) meets
     any wall segment, touching included (the orientation test with collinear-overlap cases),
     computed for all pairs x walls at once by numpy broadcasting. The embodied world uses
-    :func:`mjswarm.awareness.sight_blocker` instead.
+    :func:`mjswarm.experiments.awareness.sight_blocker` instead.
     """
     w = np.asarray([(a[0], a[1], b[0], b[1]) for a, b in walls], dtype=float).reshape(-1, 4)
     c, d = w[None, :, 0:2], w[None, :, 2:4]  # (1, walls, 2)

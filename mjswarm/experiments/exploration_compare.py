@@ -24,7 +24,7 @@ from statistics import mean
 from tqdm import tqdm
 
 from mjswarm.arena import load_arena
-from mjswarm.graphworld import GraphWorld
+from mjswarm.worlds.graphworld import GraphWorld
 
 #: Display names of the strategies.
 LABELS = {

@@ -1,9 +1,9 @@
 """Connectivity awareness on moving embodied robots (issue 6, part 4): the radio's line of
 sight and the ground truth the robots' beliefs are checked against.
 
-With ``--radio-range R`` an embodied run gives every robot a radio (:class:`mjswarm.radio.
+With ``--radio-range R`` an embodied run gives every robot a radio (:class:`mjswarm.core.radio.
 Radio`: range ``R``, one control tick of latency, links blocked by walls through
-:attr:`mjswarm.simulation.Simulation.sight`, vectorised over pairs) and a connectivity
+:attr:`mjswarm.core.simulation.Simulation.sight`, vectorised over pairs) and a connectivity
 table of internally disjoint access paths to the reference robot R1 (seed 004,
 :class:`algorithms.connectivity.tables.ConnectivityTable`, kept by each
 :class:`~algorithms.exploration.explorer.Explorer`). Each robot's *belief* is its table's
@@ -19,8 +19,8 @@ from collections.abc import Hashable, Iterable
 import networkx as nx
 import numpy as np
 
-from mjswarm.radio import Blocker
-from mjswarm.simulation import Simulation
+from mjswarm.core.radio import Blocker
+from mjswarm.core.simulation import Simulation
 
 BICONNECTED, NOT = "biconnected", "not"
 

@@ -1,6 +1,6 @@
 """Open-floor worlds for the connectivity-maintenance experiments (seeds 001 and 002).
 
-Two :class:`~mjswarm.loop.World` s with one implementation, :class:`MotionWorld`, so the
+Two :class:`~mjswarm.worlds.loop.World` s with one implementation, :class:`MotionWorld`, so the
 same controllers run on MuJoCo robots (:class:`EmbodiedFloor`) and on kinematic points
 (:class:`PointWorld`):
 
@@ -32,8 +32,8 @@ import numpy as np
 from algorithms.motion import track_velocity
 from algorithms.robot import Command, Detection, Observation
 from mjswarm.errors import MjswarmError
-from mjswarm.loop import World
-from mjswarm.robot import spark_v_geometry
+from mjswarm.worlds.loop import World
+from mjswarm.core.robot import spark_v_geometry
 
 #: The turn rate we allow the tracker (rad/s); the top speed is the robot model's.
 OMEGA_MAX_RAD_S = 2.0
@@ -206,8 +206,8 @@ class EmbodiedFloor(MotionWorld):
                  heading_noise_rad=0.0, floor_half_size_m: float = 10.0,
                  omega_max_rad_s: float = OMEGA_MAX_RAD_S, control_dt_s: float = 0.1,
                  detection_range_m: float | None = None) -> None:
-        from mjswarm.simulation import Simulation
-        from mjswarm.world import Pose2D, world_spec
+        from mjswarm.core.simulation import Simulation
+        from mjswarm.core.world import Pose2D, world_spec
 
         super().__init__(positions, present, seed, position_noise_m, heading_noise_rad,
                          omega_max_rad_s, control_dt_s, detection_range_m)

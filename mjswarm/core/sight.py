@@ -2,12 +2,12 @@
 
 Robot ``k`` sees robot ``p`` when a ray from ``k``'s centre at ``RAY_HEIGHT_M``, towards
 ``p``'s centre, hits ``p`` first; only collision geoms (group 0: walls and robots) block.
-The bearing sensor (:mod:`mjswarm.bearing`) asks this for the ordered pairs in its field of
-view, the radio (:func:`mjswarm.awareness.sight_blocker`) for both directions of every
+The bearing sensor (:mod:`mjswarm.core.bearing`) asks this for the ordered pairs in its field of
+view, the radio (:func:`mjswarm.experiments.awareness.sight_blocker`) for both directions of every
 pair in range. :class:`LineOfSight` answers each ordered pair once per world state (the
 simulation's ``state_version``), so the bearing sensor's rays, a subset of the radio's
 when both have the same range, cost nothing in a tick where the radio has already asked.
-The rays are cast by the simulation's :class:`~mjswarm.raycast.RayCaster`, which answers as
+The rays are cast by the simulation's :class:`~mjswarm.core.raycast.RayCaster`, which answers as
 ``mj_ray`` does (``tests/test_raycast.py`` checks every ordered pair against ``mj_ray``).
 """
 
@@ -17,10 +17,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from mjswarm.raycast import Rays
+from mjswarm.core.raycast import Rays
 
 if TYPE_CHECKING:
-    from mjswarm.simulation import Simulation
+    from mjswarm.core.simulation import Simulation
 
 RAY_HEIGHT_M = 0.06  # above the wheels (0.05 m), inside the chassis (0.012..0.07 m)
 _GROUP0 = np.array([1, 0, 0, 0, 0, 0], dtype=np.uint8)

@@ -34,7 +34,7 @@ import numpy as np
 
 from algorithms.robot import Command, Controller, Message, Observation
 from mjswarm.errors import MjswarmError
-from mjswarm.radio import Radio
+from mjswarm.core.radio import Radio
 
 class World(ABC):
     """The surface a :class:`Loop` drives: ``observe``, ``act``, ``step``, and ground truth
@@ -42,14 +42,14 @@ class World(ABC):
 
     Robots are ids ``0 .. n - 1``; ``present[i]`` says whether robot ``i`` is on the
     floor (absent robots wait in a depot, off the air and unseen). A world may carry a
-    :class:`~mjswarm.radio.Radio` (``radio``); it relinks the radio from the true
+    :class:`~mjswarm.core.radio.Radio` (``radio``); it relinks the radio from the true
     positions of present robots after every step.
     """
 
     n: int
     present: np.ndarray
     radio: Radio | None = None
-    #: infrastructure links by address (:class:`~mjswarm.radio.Uplink`); set per world
+    #: infrastructure links by address (:class:`~mjswarm.core.radio.Uplink`); set per world
     uplinks: dict
     #: control period (s)
     control_dt_s: float

@@ -3,7 +3,7 @@
 Each tick every robot (in team order) reads its inbox, sees its neighbours and answers
 with messages to send, which the radio delivers at the end of the tick; one tick is the
 papers' c. The robots are :class:`~algorithms.connectivity.participant.Participant`
-controllers in a :class:`StaticWorld`, run by the one :class:`~mjswarm.loop.Loop`. The harness counts messages from the radio's counters and stops at the deciding robot's
+controllers in a :class:`StaticWorld`, run by the one :class:`~mjswarm.worlds.loop.Loop`. The harness counts messages from the radio's counters and stops at the deciding robot's
 decision: the initiator (``stamps``, seed 002 Algorithm 3: tick 6N + 2 at the latest) or
 the reference (``tables`` / ``tables-2``, seed 004 with the gathering of
 :class:`algorithms.connectivity.TableCheck`: tick 2N - 1).
@@ -24,10 +24,10 @@ import numpy as np
 from algorithms.connectivity import BiconnectivityCheck, TableCheck
 from algorithms.connectivity.participant import MessagePassing, Participant
 from algorithms.robot import Command, Observation
-from mjswarm.connectivity.team import Team
+from mjswarm.experiments.connectivity.team import Team
 from mjswarm.errors import MjswarmError
-from mjswarm.loop import Loop, LoopFunctions, World
-from mjswarm.radio import Radio
+from mjswarm.worlds.loop import Loop, LoopFunctions, World
+from mjswarm.core.radio import Radio
 
 #: Method names: seed 002's stamps, seed 004's tables and its forward-two variant.
 METHODS: tuple[str, ...] = ("stamps", "tables", "tables-2")
@@ -128,7 +128,7 @@ def drive(
 
     ``robots`` maps radio ids to message-passing minds (``tick(now, inbox, neighbors)``),
     each run as a :class:`~algorithms.connectivity.participant.Participant` by one
-    :class:`~mjswarm.loop.Loop` in a :class:`StaticWorld`. A tick's messages are
+    :class:`~mjswarm.worlds.loop.Loop` in a :class:`StaticWorld`. A tick's messages are
     delivered at its end (``radio.last_batch`` counts them). Returns ``(last tick,
     capped)``; capped means more than ``message_cap`` messages were sent (checked after
     each robot's turn, so a dense flood cannot run away within a tick).

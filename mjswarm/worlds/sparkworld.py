@@ -1,12 +1,12 @@
-"""Spark V robots in MuJoCo as a :class:`~mjswarm.loop.World`.
+"""Spark V robots in MuJoCo as a :class:`~mjswarm.worlds.loop.World`.
 
-:class:`SparkWorld` wraps a :class:`~mjswarm.simulation.Simulation` (an arena, the
-bench's rows, any world from :func:`mjswarm.world.world_spec`). Each tick a robot
+:class:`SparkWorld` wraps a :class:`~mjswarm.core.simulation.Simulation` (an arena, the
+bench's rows, any world from :func:`mjswarm.core.world.world_spec`). Each tick a robot
 observes its own rangefinders, encoders, wheel speeds and battery (the simulation's
-sensor record), the bearings its :class:`~mjswarm.bearing.BearingSensor` reports, its
+sensor record), the bearings its :class:`~mjswarm.core.bearing.BearingSensor` reports, its
 radio, and the beacon under it when the loop functions keep beacons (``beacon_at``);
 its ``(v, omega)`` command goes to the wheels through the model's motors. The radio's
-links need line of sight both ways (:func:`mjswarm.awareness.sight_blocker`).
+links need line of sight both ways (:func:`mjswarm.experiments.awareness.sight_blocker`).
 
 Every robot is on the floor unless a loop function says otherwise (``present``: robots
 waiting in a depot off the arena are neither stepped nor on the air).
@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 
 from algorithms.robot import NOTHING, Command, Observation
-from mjswarm.bearing import BearingSensor
-from mjswarm.loop import World
-from mjswarm.simulation import Simulation
+from mjswarm.core.bearing import BearingSensor
+from mjswarm.worlds.loop import World
+from mjswarm.core.simulation import Simulation
 
 
 class SparkWorld(World):
@@ -95,7 +95,7 @@ class SparkWorld(World):
         self._radio_step()
 
     def place(self, i: int, pose) -> None:
-        """Put robot ``i`` on the floor at ``pose`` (:class:`~mjswarm.world.Pose2D`), at
+        """Put robot ``i`` on the floor at ``pose`` (:class:`~mjswarm.core.world.Pose2D`), at
         rest, and on the air (the experimenter's hand)."""
         self.sim.place_robot(i, pose)
         self.present[i] = True

@@ -10,7 +10,7 @@ hears the local leader's arrival; the mission lasts ``steps`` timesteps of
 ``STEP_S`` = 0.15 s (1 paper unit = 1 m, so the paper's 0.03 unit/step cap is the Spark
 V's 0.2 m/s).
 
-Each step: the radio (:class:`mjswarm.radio.Radio`, range d_c) delivers last step's
+Each step: the radio (:class:`mjswarm.core.radio.Radio`, range d_c) delivers last step's
 messages, every robot reads its sensors (detection within d_s of the positioning-sensor
 readings, with roles) and runs :class:`algorithms.maintenance.roles.RoleSwitchingRobot`,
 and the world follows the velocities for one step. Metrics (ground truth, not seen by
@@ -52,10 +52,10 @@ from algorithms.maintenance.roles import (
 )
 from algorithms.robot import Command, Controller, Observation
 from mjswarm.errors import MjswarmError
-from mjswarm.loop import Loop, LoopFunctions
-from mjswarm.openfloor import EmbodiedFloor, MotionWorld, PointWorld
-from mjswarm.radio import Radio
-from mjswarm.recording import Recorder, Recording
+from mjswarm.worlds.loop import Loop, LoopFunctions
+from mjswarm.worlds.openfloor import EmbodiedFloor, MotionWorld, PointWorld
+from mjswarm.core.radio import Radio
+from mjswarm.outputs.recording import Recorder, Recording
 
 #: Duration of one paper timestep (s): 0.03 m/step = 0.2 m/s, 0.15 rad/step = 1 rad/s.
 STEP_S = 0.15

@@ -74,8 +74,8 @@ import rerun.blueprint as rrb
 from mjswarm.arena.builder import arena_primitives
 from mjswarm.arena.spec import ArenaSpec
 from mjswarm.errors import MjswarmError, one_line
-from mjswarm.loop import Loop, LoopFunctions
-from mjswarm.robot import ENCODERS, IR_SENSORS, LINE_SENSORS
+from mjswarm.worlds.loop import Loop, LoopFunctions
+from mjswarm.core.robot import ENCODERS, IR_SENSORS, LINE_SENSORS
 
 if TYPE_CHECKING:
     from typing_extensions import Self
@@ -657,7 +657,7 @@ def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
 
 
 class Recording(LoopFunctions):
-    """Records any run of the one loop (:class:`~mjswarm.loop.Loop`) with ``recorder``:
+    """Records any run of the one loop (:class:`~mjswarm.worlds.loop.Loop`) with ``recorder``:
     every robot's pose, trail and commanded speed per tick, each controller's
     :meth:`~algorithms.robot.Controller.telemetry` as time series, and the radio graph
     every ``radio_every`` ticks when the world has a radio. Robots off the floor are

@@ -31,7 +31,7 @@ random states.
 
 Supported geom types are plane, sphere, box and cylinder (every geom of mjswarm's robots
 and arenas); a model with another ray-visible type raises :class:`MjswarmError` naming it,
-and :class:`~mjswarm.simulation.Simulation` then needs ``sensing="mujoco"``.
+and :class:`~mjswarm.core.simulation.Simulation` then needs ``sensing="mujoco"``.
 """
 
 from __future__ import annotations

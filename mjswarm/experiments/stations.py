@@ -23,7 +23,7 @@ vertices, each wanting the next: at least two, e.g. two robots swapping the ends
 edge) is granted as a whole: every robot in it gets its next vertex and leaves at once; each
 usually arrives after the previous holder has left (leaving takes a turn and a
 sidestep; arriving, a whole edge), and otherwise waits where its lane's wall ends, clear
-of the vertex area, until that robot is in its corridor (:mod:`mjswarm.embodied`). Robots never wait behind one another on a lane
+of the vertex area, until that robot is in its corridor (:mod:`mjswarm.experiments.exploration`). Robots never wait behind one another on a lane
 either: a lane leads to one vertex, held by the one robot on it. This replaces the
 scheme of issue 5, where a robot asked for the vertex ahead from its lane: a robot
 stopped by the speed rule just after leaving (still holding its vertex) behind a robot

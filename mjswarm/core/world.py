@@ -1,7 +1,7 @@
 """Building a MuJoCo world of N robots on a floor with line strips and walls.
 
 Everything is assembled with :class:`mujoco.MjSpec`: the robot template (see
-:mod:`mjswarm.robot`) is attached once per robot with the name prefix ``r<i>/``, so robot
+:mod:`mjswarm.core.robot`) is attached once per robot with the name prefix ``r<i>/``, so robot
 ``i``'s sensors are ``r<i>/line_left`` ... and its actuators ``r<i>/wheel_left`` ...
 
 Floor marks (line strips) are thin boxes in geom group 3 with ``contype = conaffinity
@@ -21,7 +21,7 @@ import mujoco
 import numpy as np
 
 from mjswarm.errors import MjswarmError
-from mjswarm.robot import DEFAULT_ROBOT_XML, ROOT_BODY, load_robot_spec
+from mjswarm.core.robot import DEFAULT_ROBOT_XML, ROOT_BODY, load_robot_spec
 
 #: Physics timestep (s) and integrator used for every world.
 PHYSICS_TIMESTEP_S = 0.002

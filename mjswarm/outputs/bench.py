@@ -5,7 +5,7 @@ floor strip, walls beside every row) and measures, in the same process and run:
 
 * ``realtime_factor``: simulated seconds per wall second of the full control loop
   (:func:`bench_loop`: one :class:`BenchRobot` controller per robot in a
-  :class:`~mjswarm.sparkworld.SparkWorld`, run by the one :class:`~mjswarm.loop.Loop`): every robot's line, IR, encoder and wheel-speed readings, its
+  :class:`~mjswarm.worlds.sparkworld.SparkWorld`, run by the one :class:`~mjswarm.worlds.loop.Loop`): every robot's line, IR, encoder and wheel-speed readings, its
   bearing sensor (+-60 degrees, 1 m, line of sight), a radio (range ``RADIO_RANGE_M``,
   links need line of sight both ways) on which every robot broadcasts a heartbeat every
   tick and reads its inbox, and per robot the seed-003 speed rule
@@ -29,15 +29,15 @@ import numpy as np
 from algorithms.collision import CollisionRule, epsilons
 from algorithms.navigation.percept import LINE_THRESHOLD_M
 from algorithms.robot import Command, Controller, Message, Observation
-from mjswarm.awareness import sight_blocker
-from mjswarm.bearing import BearingSensor
+from mjswarm.experiments.awareness import sight_blocker
+from mjswarm.core.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
-from mjswarm.loop import Loop
-from mjswarm.radio import Radio
-from mjswarm.robot import DEFAULT_ROBOT_XML
-from mjswarm.simulation import Simulation
-from mjswarm.sparkworld import SparkWorld
-from mjswarm.world import FloorStrip, Pose2D, WallSegment, world_spec
+from mjswarm.worlds.loop import Loop
+from mjswarm.core.radio import Radio
+from mjswarm.core.robot import DEFAULT_ROBOT_XML
+from mjswarm.core.simulation import Simulation
+from mjswarm.worlds.sparkworld import SparkWorld
+from mjswarm.core.world import FloorStrip, Pose2D, WallSegment, world_spec
 
 ROW_SPACING_M = 0.5
 COLUMN_SPACING_M = 0.6

@@ -1,16 +1,16 @@
 """Connectivity awareness on a static team: input files, the message-passing harness and
 the message-count comparison (seeds 002 and 004). The per-robot algorithms live in
-:mod:`algorithms.connectivity`; the radio in :mod:`mjswarm.radio`.
+:mod:`algorithms.connectivity`; the radio in :mod:`mjswarm.core.radio`.
 """
 
-from mjswarm.connectivity.harness import (
+from mjswarm.experiments.connectivity.harness import (
     DEFAULT_MESSAGE_CAP,
     METHODS,
     CheckResult,
     drive,
     run_check,
 )
-from mjswarm.connectivity.team import Team, load_team, parse_team
+from mjswarm.experiments.connectivity.team import Team, load_team, parse_team
 
 __all__ = [
     "DEFAULT_MESSAGE_CAP",

@@ -2,8 +2,8 @@
 
 Every robot is an :class:`~algorithms.exploration.explorer.Explorer` controller
 (navigator, exploration strategy, collision rule, vertex entry, optionally a
-connectivity table), run in a :class:`~mjswarm.sparkworld.SparkWorld` by the one
-:class:`~mjswarm.loop.Loop`. :class:`EmbodiedExploration` is the experiment's loop
+connectivity table), run in a :class:`~mjswarm.worlds.sparkworld.SparkWorld` by the one
+:class:`~mjswarm.worlds.loop.Loop`. :class:`EmbodiedExploration` is the experiment's loop
 functions (ARGoS's term): it owns the beacons and the vertex stations, launches robots,
 injects faults, measures and records. Choices it makes, beyond the paper:
 
@@ -15,8 +15,8 @@ injects faults, measures and records. Choices it makes, beyond the paper:
   was launched there).
 * **Vertex entry** (our addition, needed once robots have bodies): a vertex area holds
   one robot at a time; the protocol is :mod:`algorithms.exploration.entry`, carried by
-  the stations' link (:class:`~mjswarm.radio.Uplink`, one tick each way, counted in
-  ``station_messages``), and the grants are :mod:`mjswarm.stations`' (which also
+  the stations' link (:class:`~mjswarm.core.radio.Uplink`, one tick each way, counted in
+  ``station_messages``), and the grants are :mod:`mjswarm.experiments.stations`' (which also
   explains why no circular wait can form). ``--no-collision-avoidance`` turns this off
   together with the speed rule.
 * **Robots that stop** (the explorer's reasons, or a fault) release every vertex they
@@ -32,7 +32,7 @@ injects faults, measures and records. Choices it makes, beyond the paper:
 * **Connectivity awareness** (``radio_range_m``): robots carry radios (range R, one tick of
   latency, links blocked by walls) and each keeps a connectivity table of internally
   disjoint access paths to R1 (seed 004). Its *belief* is ``biconnected`` when it has
-  two such paths; the *truth* (:func:`mjswarm.awareness.truth`) is whether it shares a
+  two such paths; the *truth* (:func:`mjswarm.experiments.awareness.truth`) is whether it shares a
   biconnected component of three or more with R1 in the radio graph; both are sampled
   five times a second into ``radio_belief_agreement``. Robots in the depot or failed
   are off the air.
@@ -72,19 +72,19 @@ from algorithms.navigation import NavigatorState
 from mjswarm.arena import ArenaSpec
 from mjswarm.arena.builder import arena_world_spec
 from mjswarm.arena.geometry import LANE_OFFSET_M, VERTEX_CLEAR_RADIUS_M
-from mjswarm.awareness import BICONNECTED, NOT, sight_blocker
-from mjswarm.awareness import truth as awareness_truth
-from mjswarm.bearing import BearingSensor
+from mjswarm.experiments.awareness import BICONNECTED, NOT, sight_blocker
+from mjswarm.experiments.awareness import truth as awareness_truth
+from mjswarm.core.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
-from mjswarm.faults import Fault
-from mjswarm.graphworld import ExplorationResult, make_minds, outcome
-from mjswarm.loop import Loop, LoopFunctions
-from mjswarm.navigation import calibration, conventions
-from mjswarm.radio import Radio, Uplink
-from mjswarm.simulation import Simulation
-from mjswarm.sparkworld import SparkWorld
-from mjswarm.stations import VertexStations
-from mjswarm.world import Pose2D
+from mjswarm.experiments.faults import Fault
+from mjswarm.worlds.graphworld import ExplorationResult, make_minds, outcome
+from mjswarm.worlds.loop import Loop, LoopFunctions
+from mjswarm.worlds.navigation import calibration, conventions
+from mjswarm.core.radio import Radio, Uplink
+from mjswarm.core.simulation import Simulation
+from mjswarm.worlds.sparkworld import SparkWorld
+from mjswarm.experiments.stations import VertexStations
+from mjswarm.core.world import Pose2D
 
 #: A robot is on a vertex when within this distance of its centre (m).
 ON_VERTEX_M = 0.05
@@ -120,11 +120,11 @@ class EmbodiedConfig:
         turn_rate_rad_s: in-place turn and scan rate.
         bearing_fov_deg, bearing_range_m, bearing_noise_deg: the bearing sensor.
         radio_range_m: with a range (m), robots carry radios and keep connectivity tables
-            (:mod:`mjswarm.awareness`); None: no radio.
-        faults: injected faults (:mod:`mjswarm.faults`).
+            (:mod:`mjswarm.experiments.awareness`); None: no radio.
+        faults: injected faults (:mod:`mjswarm.experiments.faults`).
         line_noise_m, ir_noise_m: standard deviation of the line and IR rangefinders'
             Gaussian noise (m).
-        wheel_slip: scale of the wheel-slip model (:class:`mjswarm.simulation.Simulation`).
+        wheel_slip: scale of the wheel-slip model (:class:`mjswarm.core.simulation.Simulation`).
     """
 
     speed_m_s: float = PAPER_SPEED_M_S
@@ -507,7 +507,7 @@ class EmbodiedExploration(LoopFunctions):
                                     [tuple(e) for e in radio.graph().edges], beliefs, truth)
 
     def _inject_faults(self) -> None:
-        """Apply the faults whose time has come (:mod:`mjswarm.faults`), at the control
+        """Apply the faults whose time has come (:mod:`mjswarm.experiments.faults`), at the control
         tick nearest to it."""
         now = self.sim.time_s + self.sim.control_dt_s / 2.0
         while self.pending_faults and self.pending_faults[0].at_s <= now:

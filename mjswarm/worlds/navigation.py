@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from algorithms.navigation import ArenaConventions, RobotCalibration
 from mjswarm.arena import geometry
-from mjswarm.robot import RobotGeometry
+from mjswarm.core.robot import RobotGeometry
 
 
 def calibration(geom: RobotGeometry) -> RobotCalibration:

@@ -4,7 +4,7 @@ Forms (times in simulated seconds; robots numbered from 1, as in every output):
 
 ``robot:I@T``
     Robot I fails at T: it stops where it is and stays there as an obstacle, its radio
-    goes silent, and it releases every vertex it holds (:mod:`mjswarm.stations`). The
+    goes silent, and it releases every vertex it holds (:mod:`mjswarm.experiments.stations`). The
     edge it had selected stays *out* in the beacons it marked; seed 003's priority (4)
     keeps out edges as the last candidates (``Eo``), so another robot takes it once the
     unexplored edges run out: a dead robot's claim never needs to expire for the
@@ -18,7 +18,7 @@ Forms (times in simulated seconds; robots numbered from 1, as in every output):
     Every radio message sent from T1 up to T2 is lost (needs ``--radio-range``).
 
 Sensor noise and wheel slip are options of their own (``--line-noise``, ``--ir-noise``,
-``--wheel-slip``), passed to :class:`mjswarm.simulation.Simulation`.
+``--wheel-slip``), passed to :class:`mjswarm.core.simulation.Simulation`.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from algorithms.exploration import Beacon
 from mjswarm.errors import MjswarmError
 
 if TYPE_CHECKING:  # the loop functions call faults; faults act on them
-    from mjswarm.embodied import EmbodiedExploration
+    from mjswarm.experiments.exploration import EmbodiedExploration
 
 FORMS = ("robot:I@T", "beacon:V@T", "radio-blackout@T1-T2")
 _NUMBER = r"(\d+(?:\.\d*)?|\.\d+)"

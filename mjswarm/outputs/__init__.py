@@ -1,0 +1,1 @@
+"""What runs produce: rerun recordings, parameter sweeps, the benchmark."""
