@@ -87,9 +87,18 @@ class MotionWorld(World, ABC):
     def _advance(self, v: np.ndarray, omega: np.ndarray, duration_s: float) -> None:
         """Drive every present robot with ``(v, omega)`` for ``duration_s`` seconds."""
 
-    @abstractmethod
     def place(self, i: int, xy: tuple[float, float] | None, yaw: float = 0.0) -> None:
-        """Put robot ``i`` on the floor at ``xy`` (m), or take it off (``None``)."""
+        """Put robot ``i`` on the floor at ``xy`` (m) heading ``yaw`` (rad), or take it off
+        (``None``): the experimenter's hand. It is on the air exactly while on the floor."""
+        self.present[i] = xy is not None
+        self._put(i, xy, yaw)
+        self._sensed = self._detections = None
+        self.set_on_air(i, xy is not None)
+        self.relink()
+
+    @abstractmethod
+    def _put(self, i: int, xy: tuple[float, float] | None, yaw: float) -> None:
+        """Move robot ``i``'s body to ``xy`` (or to the depot for ``None``)."""
 
     def true_positions(self) -> np.ndarray:
         return self.true_poses()[:, :2]
@@ -179,13 +188,9 @@ class PointWorld(MotionWorld):
     def true_poses(self) -> np.ndarray:
         return self._poses
 
-    def place(self, i, xy, yaw=0.0) -> None:
-        self.present[i] = xy is not None
+    def _put(self, i, xy, yaw) -> None:
         if xy is not None:
             self._poses[i] = (xy[0], xy[1], yaw)
-        self._sensed = self._detections = None
-        self.set_on_air(i, xy is not None)
-        self.relink()
 
     def _advance(self, v, omega, duration_s) -> None:
         for _ in range(max(1, round(duration_s / self.dt_s))):
@@ -224,13 +229,9 @@ class EmbodiedFloor(MotionWorld):
     def true_poses(self) -> np.ndarray:
         return self.sim.poses()
 
-    def place(self, i, xy, yaw=0.0) -> None:
-        self.present[i] = xy is not None
+    def _put(self, i, xy, yaw) -> None:
         where = xy if xy is not None else self._depot[i]
         self.sim.place_robot(i, self._pose_type(where[0], where[1], yaw))
-        self._sensed = self._detections = None
-        self.set_on_air(i, xy is not None)
-        self.relink()
 
     @property
     def contacts(self) -> int:
