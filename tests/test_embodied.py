@@ -125,3 +125,15 @@ def test_cli_embodied_bad_input_is_one_line(capsys, argv, message):
     assert main(args) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
+
+
+def test_vertex_entry_is_a_counted_exchange_with_the_stations():
+    """Every departure is a request, a grant and a 'left' (issue 14), plus at most one
+    'clear' each; each robot may be on one more edge than it finished when the run ends."""
+    result = explore_embodied(load_arena("arena1"), 2, seed=0)
+    assert result.completed and result.collisions == 0
+    finished, robots = result.total_traversals, 2
+    assert 3 * finished <= result.station_messages <= 4 * (finished + robots)
+    free = explore_embodied(load_arena("arena1"), 2, seed=0, config=EmbodiedConfig(
+        collision_avoidance=False))
+    assert free.station_messages == 0  # no stations without vertex entry

@@ -227,6 +227,7 @@ def summary(result: dict) -> str:
             f"({result['realtime_factor']:.1f}x real time)"),
             (f"collisions: {result['collisions']} robot-robot contact events; "
             f"speed changes (eq. 27): {result['speed_changes']}"),
+            f"vertex entry: {result['station_messages']} messages with the stations",
         ]
         lines += [f"stopped: R{s['robot']} at {s['at_s']:.1f} s: {s['reason']}"
                   for s in result["stopped_robots"]]
