@@ -79,7 +79,7 @@ def test_bodies_keep_their_distance_and_see_the_same_episodes(cr, placement, see
             closest[0] = min([closest[0], *(math.dist(pos[a], pos[b])
                                              for a in ids for b in ids if a < b)])
 
-    bodies.loop.functions.append(Watcher())
+    bodies.loop.add(Watcher())
     for _ in range(60):
         a, b = points.step_episode(), bodies.step_episode()
         assert (a.action, a.robot, a.robots) == (b.action, b.robot, b.robots)

@@ -8,8 +8,11 @@ import networkx as nx
 import numpy as np
 import pytest
 
+from algorithms.exploration.entry import EntryGranted, LeftVertex, VertexClear
 from mjswarm.arena import load_arena
+from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
 from mjswarm.experiments.stations import VertexStations
+from mjswarm.worlds.graphworld import make_minds
 
 
 @pytest.fixture
@@ -106,3 +109,28 @@ def test_no_circular_wait_survives_a_grant(seed):
     assert len({v for _, v in granted}) == len(granted)
     assert all(stations.holder[v] == r for r, v in granted)
     assert list(nx.simple_cycles(_wait_for_graph(stations))) == []
+
+
+def test_a_swap_grants_both_robots_and_tells_each_its_vertex_is_not_yet_clear():
+    """Two robots on the two ends of an edge, each asking for the other's vertex: the
+    cycle is granted whole, and each is told that its vertex is still being left (a
+    grant told 'clear' before the other grant took effect drove robots into each other
+    in the stress grid); a robot's 'left' clears the other's way."""
+    run = EmbodiedExploration(load_arena("fig9"), make_minds("incidence-dfs", 2),
+                              EmbodiedConfig(), 0)
+    u, w = load_arena("fig9").edges[0]
+    run.launch_queue.clear()
+    run.target = [u, w]
+    run.stations.occupy(0, u)
+    run.stations.occupy(1, w)
+    run.stations.request(0, u, w, 0.0)
+    run.stations.request(1, w, u, 0.0)
+    run.before_step(run.loop)
+    run.uplink.step()
+    replies = [[m.payload for m in run.uplink.receive_for(i)] for i in (0, 1)]
+    assert replies == [[EntryGranted(clear=False)], [EntryGranted(clear=False)]]
+    assert run.target == [w, u] and run.leaving == [u, w]
+    run._station_receives(0, LeftVertex())  # R1 is in its corridor: u is free for R2
+    run.uplink.step()
+    assert [m.payload for m in run.uplink.receive_for(1)] == [VertexClear()]
+    assert run.uplink.receive_for(0) == []

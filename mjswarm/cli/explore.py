@@ -7,12 +7,15 @@ world is a function ``run_<world>(args) -> dict`` registered in :data:`WORLDS`.
 
 from __future__ import annotations
 
+from contextlib import ExitStack
+
 from algorithms.collision import PAPER_SPEED_M_S
 from algorithms.exploration import STRATEGIES
 from mjswarm.cli.output import atomic_output, check_writable, write_json
+from mjswarm.cli.video_options import add_video_options, check_video
+from mjswarm.core.robot import spark_v_geometry
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.graphworld import EDGE_TIMES, GraphWorld
-from mjswarm.core.robot import spark_v_geometry
 
 
 def run_graph(args) -> dict:
@@ -38,6 +41,7 @@ def run_embodied(args) -> dict:
     from mjswarm.experiments.faults import parse_fault
     from mjswarm.worlds.graphworld import make_minds
     from mjswarm.outputs.recording import Recorder
+    from mjswarm.outputs.video import area, filmed
 
     spec = load_arena(args.arena)
     if args.root and args.root != spec.root:
@@ -63,14 +67,18 @@ def run_embodied(args) -> dict:
         wheel_slip=_or(args.wheel_slip, 0.0))
     run = EmbodiedExploration(spec, make_minds(args.strategy, args.robots, args.seed), config,
                               args.seed)
-    if args.record:
-        with atomic_output(args.record, "recording") as temp, \
-                Recorder(temp, spec, args.robots, radio=args.radio_range is not None) \
-                as run.recorder:
+    with ExitStack() as outputs:
+        if args.record:
+            temp = outputs.enter_context(atomic_output(args.record, "recording"))
+            run.recorder = outputs.enter_context(Recorder(
+                temp, spec, args.robots, radio=args.radio_range is not None,
+                video=args.video is not None))
+        video = outputs.enter_context(atomic_output(args.video, "video")) if args.video else None
+        with filmed(run.loop, video, area(spec.vertices.values()), check_video(args),
+                    f"{spec.name}, {args.robots} robots", run.dropped_beacons, run.recorder):
             result = run.run(progress=True)
-    else:
-        result = run.run(progress=True)
-    return {"world": "embodied", **result.to_dict(), "recording": args.record}
+    return {"world": "embodied", **result.to_dict(), "recording": args.record,
+            "video": args.video}
 
 
 def _or(value, default):
@@ -159,6 +167,7 @@ def register(subparsers) -> None:
     embodied.add_argument("--record", default=None, metavar="FILE.rrd",
                           help="write a rerun recording of the run (open it with "
                                "`mjswarm view FILE.rrd`)")
+    add_video_options(embodied)
     parser.add_argument("--json", default=None, metavar="PATH|-",
                         help="write the result as JSON to PATH, or to stdout with '-'")
     parser.set_defaults(func=run)
@@ -170,7 +179,7 @@ EMBODIED_ONLY = {
     "launch_interval": "--launch-interval", "launch_order": "--launch-order",
     "radio_range": "--radio-range", "stall_timeout": "--stall-timeout", "fault": "--fault",
     "line_noise": "--line-noise", "ir_noise": "--ir-noise", "wheel_slip": "--wheel-slip",
-    "record": "--record",
+    "record": "--record", "video": "--video", "video_speed": "--video-speed",
 }
 
 
@@ -190,6 +199,7 @@ def check_options(args) -> None:
     if args.launch_interval is not None and not args.launch_interval >= 0:
         raise MjswarmError(f"--launch-interval must be >= 0 s, got {args.launch_interval:g}")
     check_writable(args.json, "JSON")
+    check_video(args)
 
 
 def run(args) -> int:
@@ -239,4 +249,6 @@ def summary(result: dict) -> str:
                 f"{100 * (result['radio_belief_agreement'] or 0):.1f} % of samples")
         if result["recording"]:
             lines.append(f"recording: {result['recording']}")
+        if result["video"]:
+            lines.append(f"video: {result['video']}")
     return "\n".join(lines)

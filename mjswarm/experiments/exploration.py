@@ -251,6 +251,8 @@ class EmbodiedExploration(LoopFunctions):
         #: each robot's vertex: the one it stands on or was granted; the one it is leaving
         self.target: list[str | None] = [None] * k
         self.leaving: list[str | None] = [None] * k
+        #: robots granted a vertex whose previous holder has not yet left it
+        self.awaiting_clear: set[int] = set()
         self.paths = [[spec.root] for _ in range(k)]
         self._calls_seen = [0] * k
         self.last_launch = -math.inf
@@ -350,10 +352,14 @@ class EmbodiedExploration(LoopFunctions):
         for message in self.uplink.receive():
             self._station_receives(message.sender, message.payload)
         if self.config.collision_avoidance:
-            for i, vertex in self.stations.grant():
+            granted = self.stations.grant()
+            for i, vertex in granted:  # a cycle's grants all take effect at once ...
                 self.leaving[i], self.target[i] = self.target[i], vertex
-                busy = any(v == vertex for j, v in enumerate(self.leaving) if j != i)
-                self.uplink.reply(i, EntryGranted(clear=not busy))
+            for i, vertex in granted:  # ... before anyone is told whether its vertex is clear
+                clear = not any(v == vertex for j, v in enumerate(self.leaving) if j != i)
+                if not clear:
+                    self.awaiting_clear.add(i)
+                self.uplink.reply(i, EntryGranted(clear=clear))
                 self._event(i, f"R{i + 1} granted {vertex}")
 
     def after_act(self, loop: Loop, i: int) -> None:
@@ -387,6 +393,10 @@ class EmbodiedExploration(LoopFunctions):
     def should_stop(self, loop: Loop) -> bool:
         return self.finished()
 
+    def dropped_beacons(self) -> list[tuple[float, float]]:
+        """Where beacons have been dropped so far (m): the vertices a video marks."""
+        return [self.spec.vertices[v] for v, b in self.beacons.items() if b.id is not None]
+
     # ------------------------------------------------------------------ stations
     def _beacon_at(self, i: int) -> Beacon | None:
         """The beacon robot ``i`` can read now: its vertex's, if it stands on the centre
@@ -411,9 +421,7 @@ class EmbodiedExploration(LoopFunctions):
         elif isinstance(payload, LeftVertex):
             left, self.leaving[i] = self.leaving[i], None
             self.stations.release(i, left)
-            for j, v in enumerate(self.target):
-                if j != i and v == left and left not in self.leaving:
-                    self.uplink.reply(j, VertexClear())
+            self._tell_clear()
         elif isinstance(payload, Halted):
             self._release(i)
 
@@ -426,6 +434,15 @@ class EmbodiedExploration(LoopFunctions):
         if distance < VERTEX_CLEAR_RADIUS_M:
             self.stations.occupy(i, vertex)
         self.leaving[i] = None
+        self.awaiting_clear.discard(i)
+        self._tell_clear()
+
+    def _tell_clear(self) -> None:
+        """Tell the robots waiting for a vertex whose previous holder has now left it."""
+        for j in sorted(self.awaiting_clear):
+            if self.target[j] not in self.leaving:
+                self.awaiting_clear.discard(j)
+                self.uplink.reply(j, VertexClear())
 
     def _launch_if_free(self) -> None:
         if not self.launch_queue:

@@ -198,6 +198,8 @@ class Recorder:
         bounds_m: ``(x_min, y_min, x_max, y_max)`` of the area to frame (default: the
             arena's vertices; needed without an arena).
         name: the recording's name (default: the arena's name and the team size).
+        video: whether the run also makes a video that :meth:`log_video` will add (the
+            blueprint then shows a camera view beside the 3-D view).
 
     Raises :class:`MjswarmError` (one line) if the file cannot be created or a
     parameter is impossible. Use as a context manager or call :meth:`close`.
@@ -216,6 +218,7 @@ class Recorder:
         sensors: bool = True,
         bounds_m: tuple[float, float, float, float] | None = None,
         name: str | None = None,
+        video: bool = False,
     ) -> None:
         if int(n_robots) != n_robots or n_robots < 1:
             raise MjswarmError(f"a recording needs at least 1 robot, got {n_robots}")
@@ -248,7 +251,8 @@ class Recorder:
         self._stream.set_log_tick_enabled(False)
         self._stream.set_log_time_enabled(False)
         self._stream.send_recording_name(name or f"{arena.name}, {n} robots")
-        self._stream.send_blueprint(_blueprint(bounds_m, n, trail_window_s, radio, sensors))
+        self._stream.send_blueprint(_blueprint(bounds_m, n, trail_window_s, radio, sensors,
+                                               video))
         self._closed = False
 
         b = self._chunk
@@ -575,6 +579,25 @@ class Recorder:
             return self._poses[self._rows - 1, :, :2].copy()
         return self._latest_xy
 
+    def log_video(self, path: str | Path, frame_times_s: Sequence[float]) -> None:
+        """Add a finished video file (``camera/video``, rerun's video asset) and, on the
+        ``sim_time`` timeline, a reference to each of its frames (``camera``): frame k is
+        shown from simulated time ``frame_times_s[k]`` on."""
+        self._check_open()
+        asset = rr.AssetVideo(path=path)
+        self._stream.log("camera/video", asset, static=True)
+        stamps = asset.read_frame_timestamps_nanos()
+        if len(stamps) != len(frame_times_s):
+            raise MjswarmError(f"video {path} has {len(stamps)} frames, the run drew "
+                               f"{len(frame_times_s)}")
+        self._stream.send_columns(
+            "camera",
+            [rr.TimeColumn("sim_time", duration=np.asarray(frame_times_s, float))],
+            rr.VideoFrameReference.columns_nanos(stamps),
+        )
+        self._stream.log("camera", rr.VideoFrameReference.from_fields(
+            video_reference="camera/video"), static=True)
+
     # --- lifetime ----------------------------------------------------------------------
 
     def _check_open(self) -> None:
@@ -598,7 +621,8 @@ class Recorder:
 
 
 def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
-               trail_window_s: float, radio: bool, sensors: bool) -> rrb.Blueprint:
+               trail_window_s: float, radio: bool, sensors: bool,
+               video: bool = False) -> rrb.Blueprint:
     """The layout the file opens with: 3-D scene + event log on the left; explored
     graphs, beacons (and the radio graph) on the top right; time series (speeds,
     controller state, and the sensors when recorded) on the bottom right."""
@@ -644,6 +668,8 @@ def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
            plot("encoders (rad)", "sensors/encoders"),
            plot("battery (V)", "battery")] if sensors else []),
     )
+    if video:
+        scene = rrb.Horizontal(scene, rrb.Spatial2DView(name="camera", origin="/camera"))
     return rrb.Blueprint(
         rrb.Horizontal(
             rrb.Vertical(scene, rrb.TextLogView(name="events", origin="/events"),

@@ -168,22 +168,28 @@ class LoopFunctions:
 class Loop:
     """Runs ``controllers`` (by robot id) in ``world`` with ``functions``' hooks.
 
-    ``stopped`` holds the robots the loop no longer steps (a controller that ended, a
-    robot that failed); loop functions add to it with :meth:`halt`.
+    ``halted`` holds the robots the loop no longer steps (a robot that failed); loop
+    functions add to it with :meth:`halt`.
     """
 
     def __init__(self, world: World, controllers: Mapping[int, Controller],
                  functions: Iterable[LoopFunctions] = ()) -> None:
         self.world = world
         self.controllers: dict[int, Controller] = dict(controllers)
-        self.functions = list(functions)
+        self.functions: list[LoopFunctions] = []
+        self._after_act: list[LoopFunctions] = []
         self.ticks = 0
         self.halted: set[int] = set()
         self._stop = False
-        base = LoopFunctions.after_act
-        self._after_act = [f for f in self.functions if type(f).after_act is not base]
-        for f in self.functions:
-            f.initialize(self)
+        for f in functions:
+            self.add(f)
+
+    def add(self, function: LoopFunctions) -> None:
+        """Hook in one more loop function (a recording, a video); it is initialized now."""
+        self.functions.append(function)
+        if type(function).after_act is not LoopFunctions.after_act:
+            self._after_act.append(function)
+        function.initialize(self)
 
     def halt(self, robot: int) -> None:
         """Stop stepping ``robot`` for good (its body stays where it is, standing still)."""
