@@ -17,7 +17,8 @@ from mjswarm.cli.output import interrupted_outputs
 from mjswarm.errors import MjswarmError
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ("bench", "arena", "explore", "compare", "view", "connectivity", "experiment", "sweep")
+SUBCOMMANDS = ("bench", "arena", "explore", "compare", "view", "plot", "connectivity",
+               "experiment", "sweep")
 
 
 def register_modules(subparsers, prefix: str, names: tuple[str, ...]) -> None:

@@ -4,14 +4,16 @@ from __future__ import annotations
 
 import argparse
 import sys
-from contextlib import nullcontext
 import time
+from contextlib import ExitStack
 
 from tqdm import tqdm
 
 from algorithms.maintenance.biconnected import PLACEMENTS
 from mjswarm.cli.output import atomic_output, check_writable, write_json
-from mjswarm.experiments.coverage import WORLDS, run_coverage
+from mjswarm.cli.video_options import add_video_options, check_video
+from mjswarm.experiments.coverage import WORLDS, area, run_coverage
+from mjswarm.outputs.video import Video
 
 
 def register(subparsers) -> None:
@@ -46,19 +48,26 @@ def register(subparsers) -> None:
                         help="write a rerun recording of the run: poses and trails, each "
                              "robot's controller state, the radio graph, events"
 )
+    add_video_options(parser)
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     check_writable(args.json, "JSON")  # before any work, not after it
     check_writable(args.record, "recording")
+    speedup = check_video(args)
     start = time.perf_counter()
-    recording = atomic_output(args.record, "recording") if args.record else nullcontext()
-    with recording as temp, tqdm(total=args.episodes, desc="episodes", unit="ep",
-                                 file=sys.stderr, disable=not sys.stderr.isatty()) as bar:
+    with ExitStack() as outputs:
+        record = outputs.enter_context(atomic_output(args.record, "recording")) \
+            if args.record else None
+        video = Video(outputs.enter_context(atomic_output(args.video, "video")),
+                      area(args.cr, args.region_diameter), speedup,
+                      title=f"coverage, cr {args.cr:g}") if args.video else None
+        bar = outputs.enter_context(tqdm(total=args.episodes, desc="episodes", unit="ep",
+                                         file=sys.stderr, disable=not sys.stderr.isatty()))
         result = run_coverage(args.cr, args.placement, args.episodes, args.seed, args.world,
-                              args.region_diameter, progress=bar.update,
-                              record=temp)
+                              args.region_diameter, progress=bar.update, record=record,
+                              video=video)
     data = result.to_dict()
     data["wall_time_s"] = round(time.perf_counter() - start, 2)
     if write_json(data, args.json):

@@ -41,7 +41,7 @@ def run_embodied(args) -> dict:
     from mjswarm.experiments.faults import parse_fault
     from mjswarm.worlds.graphworld import make_minds
     from mjswarm.outputs.recording import Recorder
-    from mjswarm.outputs.video import area, filmed
+    from mjswarm.outputs.video import Video, area, filming
 
     spec = load_arena(args.arena)
     if args.root and args.root != spec.root:
@@ -73,9 +73,13 @@ def run_embodied(args) -> dict:
             run.recorder = outputs.enter_context(Recorder(
                 temp, spec, args.robots, radio=args.radio_range is not None,
                 video=args.video is not None))
-        video = outputs.enter_context(atomic_output(args.video, "video")) if args.video else None
-        with filmed(run.loop, video, area(spec.vertices.values()), check_video(args),
-                    f"{spec.name}, {args.robots} robots", run.dropped_beacons, run.recorder):
+        video = None
+        if args.video:
+            video = Video(outputs.enter_context(atomic_output(args.video, "video")),
+                          area(spec.vertices.values()), check_video(args),
+                          marks=run.dropped_beacons, title=f"{spec.name}, {args.robots} robots")
+            run.loop.add(video)
+        with filming(video, run.recorder):
             result = run.run(progress=True)
     return {"world": "embodied", **result.to_dict(), "recording": args.record,
             "video": args.video}

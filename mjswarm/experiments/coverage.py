@@ -42,7 +42,8 @@ two worlds' coverages can differ after a removal.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from contextlib import ExitStack
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -56,6 +57,7 @@ from mjswarm.worlds.openfloor import EmbodiedFloor, MotionWorld, PointWorld
 from mjswarm.core.robot import spark_v_geometry
 from mjswarm.core.radio import Radio
 from mjswarm.outputs.recording import Recorder, Recording
+from mjswarm.outputs.video import Video, filming
 
 MAX_ROBOTS = 10
 START_ROBOTS = 5
@@ -127,11 +129,14 @@ class CoverageRun(LoopFunctions):
         clearance_m: distance robots keep (m); default ``CLEARANCE_M`` embodied, 0 points.
         recorder: a :class:`~mjswarm.outputs.recording.Recorder` for ``MAX_ROBOTS`` robots without
             sensors (:func:`recorder_for`), or None.
+        functions: more loop functions (e.g. a :class:`~mjswarm.outputs.video.Video`),
+            hooked in before the team is built.
     """
 
     def __init__(self, cr: float, placement: str = "heuristic", world: str = "point",
                  seed: int = 0, region_diameter_m: float = 1.0, max_ticks: int = 20_000,
-                 clearance_m: float | None = None, recorder: Recorder | None = None) -> None:
+                 clearance_m: float | None = None, recorder: Recorder | None = None,
+                 functions: Sequence[LoopFunctions] = ()) -> None:
         if not (math.isfinite(cr) and cr > 1.0):
             raise MjswarmError(f"cr must be a number above 1, got {cr}")
         if placement not in PLACEMENTS:
@@ -166,7 +171,8 @@ class CoverageRun(LoopFunctions):
                                        floor_half_size_m=half, control_dt_s=tick)
         self.world.attach_radio(Radio(range(MAX_ROBOTS), range_m=self.params.link_m))
         self.recording = Recording(recorder) if recorder is not None else None
-        self.loop = Loop(self.world, {}, [self] + ([self.recording] if self.recording else []))
+        self.loop = Loop(self.world, {}, [self] + ([self.recording] if self.recording else [])
+                         + list(functions))
         self._ticks = 0
         for _ in range(START_ROBOTS):
             self._episode("add", -1)
@@ -269,28 +275,36 @@ class CoverageRun(LoopFunctions):
             offset += 0.1
 
 
-def recorder_for(path: str | Path, cr: float, world: str,
-                 region_diameter_m: float = 1.0) -> Recorder:
+def area(cr: float, region_diameter_m: float = 1.0) -> tuple[float, float, float, float]:
+    """The square (m) that recordings and videos frame: the team stays near the origin."""
+    half = region_diameter_m * (cr + 1.0) / 2.0
+    return (-half, -half, half, half)
+
+
+def recorder_for(path: str | Path, cr: float, world: str, region_diameter_m: float = 1.0,
+                 video: bool = False) -> Recorder:
     """A recorder for a coverage run: ``MAX_ROBOTS`` robots, radios, no arena."""
-    half = 3.0 * region_diameter_m * cr
-    return Recorder(path, None, MAX_ROBOTS, radio=True, sensors=False,
-                    bounds_m=(-half, -half, half, half),
+    return Recorder(path, None, MAX_ROBOTS, radio=True, sensors=False, video=video,
+                    bounds_m=area(cr, region_diameter_m),
                     name=f"biconnected coverage, cr {cr:g}, {world} world")
 
 
 def run_coverage(cr: float, placement: str = "heuristic", episodes: int = 100,
                  seed: int = 0, world: str = "embodied", region_diameter_m: float = 1.0,
                  progress: Callable[[], None] | None = None,
-                 record: str | Path | None = None) -> CoverageResult:
+                 record: str | Path | None = None, video: Video | None = None) -> CoverageResult:
     """Build the team of 5 and run ``episodes`` random add / remove episodes; with
-    ``record``, write a rerun recording there."""
+    ``record``, write a rerun recording there; with ``video``, film the run."""
     if episodes < 1:
         raise MjswarmError(f"need at least one episode, got {episodes}")
-    if record is None:
-        return CoverageRun(cr, placement, world, seed, region_diameter_m).run(episodes, progress)
-    with recorder_for(record, cr, world, region_diameter_m) as recorder:
-        run = CoverageRun(cr, placement, world, seed, region_diameter_m, recorder=recorder)
-        return run.run(episodes, progress)
+    extra = [video] if video is not None else []
+    with ExitStack() as outputs:
+        recorder = None if record is None else outputs.enter_context(
+            recorder_for(record, cr, world, region_diameter_m, video is not None))
+        run = CoverageRun(cr, placement, world, seed, region_diameter_m, recorder=recorder,
+                          functions=extra)
+        with filming(video, recorder):
+            return run.run(episodes, progress)
 
 
 __all__ = ["CoverageResult", "CoverageRun", "Episode", "run_coverage"]

@@ -78,6 +78,7 @@ from mjswarm.core.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.faults import Fault
 from mjswarm.worlds.graphworld import ExplorationResult, make_minds, outcome
+from mjswarm.outputs.recording import contact_event
 from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.navigation import calibration, conventions
 from mjswarm.core.radio import Radio, Uplink
@@ -255,6 +256,7 @@ class EmbodiedExploration(LoopFunctions):
         self.awaiting_clear: set[int] = set()
         self.paths = [[spec.root] for _ in range(k)]
         self._calls_seen = [0] * k
+        self._contacts_logged = 0
         self.last_launch = -math.inf
         self.last_progress_s = 0.0
         self.declared: tuple[float, int, str] | None = None
@@ -385,10 +387,14 @@ class EmbodiedExploration(LoopFunctions):
         if self.recorder is not None:
             readings = sim.readings()
             bearings = self.world.bearing_readings()
-            self.recorder.log_tick(sim.step_count, sim.time_s, sim.poses(), readings["line"],
+            poses = sim.poses()
+            self.recorder.log_tick(sim.step_count, sim.time_s, poses, readings["line"],
                                    readings["ir"], np.array(self._last_speed),
                                    [list(b.items()) for b in bearings],
                                    readings["encoder"], readings["battery"])
+            for _, i, j in sim.collisions.events[self._contacts_logged:]:
+                self._event(None, contact_event(i, j, poses))
+            self._contacts_logged = sim.collisions.count
 
     def should_stop(self, loop: Loop) -> bool:
         return self.finished()

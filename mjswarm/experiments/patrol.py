@@ -35,6 +35,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from contextlib import ExitStack
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -56,6 +57,7 @@ from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.openfloor import EmbodiedFloor, MotionWorld, PointWorld
 from mjswarm.core.radio import Radio
 from mjswarm.outputs.recording import Recorder, Recording
+from mjswarm.outputs.video import Video, filming
 
 #: Duration of one paper timestep (s): 0.03 m/step = 0.2 m/s, 0.15 rad/step = 1 rad/s.
 STEP_S = 0.15
@@ -274,10 +276,12 @@ class PatrolMission(LoopFunctions):
 def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
               params: RoleParams | None = None, every_step_aat: bool = False,
               sample_every: int = 10, progress: Callable[[int], None] | None = None,
-              keep_history: bool = False, recorder: Recorder | None = None) -> TrialResult:
+              keep_history: bool = False, recorder: Recorder | None = None,
+              video: Video | None = None) -> TrialResult:
     """One patrol mission of ``steps`` timesteps with ``robots`` robots (base station
     included). ``every_step_aat`` drives the robots with the baseline instead of
-    Algorithm 2; ``recorder`` (:func:`recorder_for`) records the mission."""
+    Algorithm 2; ``recorder`` (:func:`recorder_for`) records the mission and ``video``
+    films it (the caller closes both)."""
     params = params or RoleParams()
     if steps < 1 or sample_every < 1:
         raise MjswarmError("steps and sample interval must be at least 1")
@@ -300,6 +304,8 @@ def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
     if recorder is not None:
         mission.recording = Recording(recorder)
         functions.append(mission.recording)
+    if video is not None:
+        functions.append(video)
     loop = Loop(floor, dict(enumerate(timed)), functions)
     loop.run(max_ticks=steps)
     robot_steps = robots * steps
@@ -371,30 +377,39 @@ def summarize(trials: list[TrialResult]) -> dict:
     }
 
 
-def recorder_for(path: str | Path, robots: int, world: str) -> Recorder:
-    """A recorder for one mission: the robots, their radios, the target square."""
+def area(robots: int) -> tuple[float, float, float, float]:
+    """The target square (m), which recordings and videos frame."""
     side = 1.8 * math.sqrt(robots)
-    return Recorder(path, None, robots, radio=True, sensors=False,
-                    bounds_m=(0.0, 0.0, side, side), name=f"patrol, N = {robots}, {world} world")
+    return (0.0, 0.0, side, side)
+
+
+def recorder_for(path: str | Path, robots: int, world: str, video: bool = False) -> Recorder:
+    """A recorder for one mission: the robots, their radios, the target square."""
+    return Recorder(path, None, robots, radio=True, sensors=False, bounds_m=area(robots),
+                    name=f"patrol, N = {robots}, {world} world", video=video)
 
 
 def run_patrol(robots: int, trials: int = 1, seed: int = 0, world: str = "embodied",
                steps: int = 2000, params: RoleParams | None = None,
                every_step_aat: bool = False,
                progress: Callable[[int], None] | None = None,
-               record: str | Path | None = None) -> dict:
+               record: str | Path | None = None, video: Video | None = None) -> dict:
     """``trials`` missions (seeds ``seed .. seed + trials - 1``), summarised; with
-    ``record``, a rerun recording of the (single) mission is written there."""
+    ``record`` (a rerun recording) or ``video``, of the single mission."""
     if trials < 1:
         raise MjswarmError(f"need at least one trial, got {trials}")
     if world not in WORLDS:
         raise MjswarmError(f"unknown world {world!r} (choose from {', '.join(WORLDS)})")
-    if record is not None:
+    if record is not None or video is not None:
         if trials != 1:
-            raise MjswarmError(f"a recording holds one mission; got {trials} trials")
-        with recorder_for(record, robots, world) as recorder:
-            return summarize([run_trial(robots, seed, world, steps, params, every_step_aat,
-                                        progress=progress, recorder=recorder)])
+            raise MjswarmError(f"a recording or video holds one mission; got {trials} trials")
+        with ExitStack() as outputs:
+            recorder = None if record is None else outputs.enter_context(
+                recorder_for(record, robots, world, video is not None))
+            with filming(video, recorder):
+                return summarize([run_trial(robots, seed, world, steps, params,
+                                            every_step_aat, progress=progress,
+                                            recorder=recorder, video=video)])
     results = [run_trial(robots, seed + k, world, steps, params, every_step_aat,
                          progress=progress) for k in range(trials)]
     return summarize(results)

@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import colorsys
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -99,6 +100,18 @@ _ROOT_COLOR = (240, 190, 20, 255)
 _AGREE_COLOR = (40, 170, 60, 255)
 _DISAGREE_COLOR = (220, 40, 40, 255)
 _NO_BELIEF_COLOR = (140, 140, 140, 255)
+
+
+#: How a contact event reads in a recording's event log (``mjswarm plot`` parses it back).
+CONTACT_EVENT = "contact {a}-{b} at ({x:.3f}, {y:.3f}) m"
+CONTACT_PATTERN = re.compile(r"contact (R\d+)-(R\d+) at \((-?[\d.]+), (-?[\d.]+)\) m")
+
+
+def contact_event(i: int, j: int, poses: np.ndarray) -> str:
+    """The event text of a contact between robots ``i`` and ``j`` (0-based), placed at the
+    midpoint of their positions (``poses``: (N, 3) in m)."""
+    x, y = (poses[i, :2] + poses[j, :2]) / 2.0
+    return CONTACT_EVENT.format(a=robot_name(i), b=robot_name(j), x=x, y=y)
 
 
 def robot_name(i: int) -> str:
@@ -692,13 +705,18 @@ class Recording(LoopFunctions):
     def __init__(self, recorder: Recorder, radio_every: int = 10) -> None:
         self.recorder = recorder
         self.radio_every = radio_every
+        self._contacts = 0
 
     def after_step(self, loop: Loop) -> None:
         world, rec = loop.world, self.recorder
         step, now = loop.ticks, world.time_s
+        poses = world.true_poses()
         state = {i: c.telemetry() for i, c in loop.controllers.items() if world.present[i]}
-        rec.log_tick(step, now, world.true_poses(), speed=world.commanded_speeds(),
-                     state=state)
+        rec.log_tick(step, now, poses, speed=world.commanded_speeds(), state=state)
+        events = world.contact_events() or []
+        for _, i, j in events[self._contacts:]:
+            rec.log_event(step, now, contact_event(i, j, poses))
+        self._contacts = len(events)
         if world.radio is not None and step % self.radio_every == 0:
             rec.log_radio(step, now, [tuple(e) for e in world.radio.graph().edges])
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -79,7 +80,9 @@ class MujocoCamera:
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
         try:
-            self.renderer = mujoco.Renderer(model, height, width, max_geom=20_000)
+            with warnings.catch_warnings():  # a failing backend also warns; one line says it
+                warnings.simplefilter("ignore")
+                self.renderer = mujoco.Renderer(model, height, width, max_geom=20_000)
         except Exception as exc:  # noqa: BLE001 - any GL failure is the same to the user
             backend = os.environ.get("MUJOCO_GL", "(default)")
             raise MjswarmError(f"cannot render video: no working OpenGL backend "
@@ -148,7 +151,7 @@ class PlotCamera:
         self.radius_m = radius_m
         dpi = 100
         self.figure = plt.figure(figsize=(width / dpi, height / dpi), dpi=dpi)
-        self.axes = self.figure.add_axes((0.06, 0.08, 0.9, 0.88))
+        self.axes = self.figure.add_axes((0.1, 0.1, 0.86, 0.8))
         x0, y0, x1, y1 = bounds_m
         mx, my = (x1 - x0) * MARGIN + 0.2, (y1 - y0) * MARGIN + 0.2
         self.limits = (x0 - mx, x1 + mx, y0 - my, y1 + my)
@@ -184,19 +187,22 @@ class Video(LoopFunctions):
 
     Args:
         path: where the video goes.
-        camera: draws one frame (:class:`MujocoCamera` or :class:`PlotCamera`).
+        bounds_m: ``(x_min, y_min, x_max, y_max)`` of the area to frame (m); the camera
+            (:func:`camera_for` the loop's world) is made when the loop starts.
         speedup: simulated seconds per second of video.
         fps: frames per second of video.
         marks: ``marks()`` gives the points (m) to mark on the next frame, or None.
         title: written on every frame before the time.
     """
 
-    def __init__(self, path: str | Path, camera: Camera, speedup: float = DEFAULT_SPEEDUP,
-                 fps: int = FPS, marks: Callable[[], Sequence[tuple[float, float]]] | None = None,
+    def __init__(self, path: str | Path, bounds_m: Sequence[float],
+                 speedup: float = DEFAULT_SPEEDUP, fps: int = FPS,
+                 marks: Callable[[], Sequence[tuple[float, float]]] | None = None,
                  title: str = "") -> None:
         if not (math.isfinite(speedup) and speedup > 0):
             raise MjswarmError(f"video speed-up must be a positive number, got {speedup}")
-        self.path, self.camera, self.speedup, self.fps = Path(path), camera, speedup, fps
+        self.path, self.bounds_m, self.speedup, self.fps = Path(path), bounds_m, speedup, fps
+        self.camera: Camera | None = None
         self.marks, self.title = marks, title
         #: simulated time (s) of each frame drawn so far
         self.frame_times_s: list[float] = []
@@ -211,6 +217,7 @@ class Video(LoopFunctions):
         return self.speedup / self.fps
 
     def initialize(self, loop: Loop) -> None:
+        self.camera = camera_for(loop.world, self.bounds_m)
         self._trails = [[] for _ in range(loop.world.n)]
         self._frame(loop)
 
@@ -255,7 +262,9 @@ class Video(LoopFunctions):
         if self._writer is not None:
             self._writer.close()  # ffmpeg finishes the file
             self._writer = None
-        self.camera.close()
+        if self.camera is not None:
+            self.camera.close()
+            self.camera = None
 
 
 def area(points: Sequence[tuple[float, float]]) -> tuple[float, float, float, float]:
@@ -271,21 +280,15 @@ def camera_for(world, bounds_m: Sequence[float]) -> Camera:
 
 
 @contextmanager
-def filmed(loop: Loop, path: str | Path | None, bounds_m: Sequence[float],
-           speedup: float = DEFAULT_SPEEDUP, title: str = "",
-           marks: Callable[[], Sequence[tuple[float, float]]] | None = None,
-           recorder=None) -> Iterator[Video | None]:
-    """Film ``loop``'s run into ``path`` while the block runs (nothing when ``path`` is
-    None). When the block ends normally the finished video also goes into ``recorder``
-    (:meth:`mjswarm.outputs.recording.Recorder.log_video`), if one is given."""
-    if path is None:
-        yield None
+def filming(video: Video | None, recorder=None) -> Iterator[None]:
+    """Finish ``video`` (if any) when the block ends; when it ends normally the video also
+    goes into ``recorder`` (:meth:`mjswarm.outputs.recording.Recorder.log_video`)."""
+    if video is None:
+        yield
         return
-    video = Video(path, camera_for(loop.world, bounds_m), speedup, marks=marks, title=title)
-    loop.add(video)
     try:
-        yield video
+        yield
     finally:
         video.close()
     if recorder is not None:
-        recorder.log_video(path, video.frame_times_s)
+        recorder.log_video(video.path, video.frame_times_s)

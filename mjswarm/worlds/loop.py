@@ -86,6 +86,12 @@ class World(ABC):
     @property
     def contacts(self) -> int | None:
         """Robot-robot contact events so far (None: a world without bodies)."""
+        events = self.contact_events()
+        return None if events is None else len(events)
+
+    def contact_events(self) -> list[tuple[float, int, int]] | None:
+        """Every robot-robot contact event so far: (time s, robot i, robot j), i < j
+        (None: a world without bodies)."""
         return None
 
     # -- the radio, shared by every world ----------------------------------------------

@@ -233,9 +233,8 @@ class EmbodiedFloor(MotionWorld):
         where = xy if xy is not None else self._depot[i]
         self.sim.place_robot(i, self._pose_type(where[0], where[1], yaw))
 
-    @property
-    def contacts(self) -> int:
-        return self.sim.collisions.count
+    def contact_events(self) -> list[tuple[float, int, int]]:
+        return self.sim.collisions.events
 
     def _advance(self, v, omega, duration_s) -> None:
         self.sim.set_velocity(v, omega)

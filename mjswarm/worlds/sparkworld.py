@@ -57,9 +57,8 @@ class SparkWorld(World):
     def true_poses(self) -> np.ndarray:
         return self.sim.poses()
 
-    @property
-    def contacts(self) -> int:
-        return self.sim.collisions.count
+    def contact_events(self) -> list[tuple[float, int, int]]:
+        return self.sim.collisions.events
 
     def observe(self, i: int) -> Observation:
         if self._version != self.sim.state_version:  # one read of every sensor per state
