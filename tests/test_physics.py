@@ -237,3 +237,23 @@ def test_model_without_sensors_is_rejected(tmp_path):
 def test_control_rate_must_divide_physics_rate():
     with pytest.raises(MjswarmError, match="must divide"):
         Simulation(world_spec([Pose2D(0, 0)]), control_hz=33.0)
+
+
+def test_geom_groups_follow_menagerie():
+    """Visual geoms (no contacts) in group 2, everything that collides in
+    COLLISION_GROUP (robots, walls, floor), floor marks in STRIP_GROUP."""
+    import mujoco
+
+    from mjswarm.core.world import COLLISION_GROUP, STRIP_GROUP, FloorStrip
+
+    sim = Simulation(world_spec([Pose2D(0, 0, 0)], strips=[FloorStrip((0, 0), (1, 0))],
+                                walls=[WallSegment((0, 0.3), (1, 0.3))]))
+    m = sim.model
+    collides = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
+    robot = sim.geom_robot >= 0
+    assert set(m.geom_group[robot & ~collides]) == {2}
+    assert set(m.geom_group[collides]) == {COLLISION_GROUP}
+    names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g) for g in range(m.ngeom)]
+    assert m.geom_group[names.index("strip0")] == STRIP_GROUP
+    assert {"floor", "wall0", "r0/battery", "r0/chassis"} <= {
+        n for n, c in zip(names, collides) if c}

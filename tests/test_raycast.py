@@ -23,7 +23,7 @@ from mjswarm.errors import MjswarmError
 from mjswarm.core.raycast import RayCaster, Rays
 from mjswarm.core.sight import LineOfSight
 from mjswarm.core.simulation import GRID_SENSING_MIN_ROBOTS, Simulation
-from mjswarm.core.world import Pose2D, world_spec
+from mjswarm.core.world import COLLISION_GROUP, Pose2D, world_spec
 
 ROBOTS = 12
 TOLERANCE = 1e-9
@@ -111,7 +111,8 @@ def test_line_sensors_of_tipped_robots_use_the_fallback():
 
 @pytest.mark.parametrize("seed", range(4))
 def test_ray_caster_equals_mj_ray(seed):
-    """Random rays of random lengths from near the robots, all groups and group 0 only:
+    """Random rays of random lengths from near the robots, all groups and the collision
+    group only:
     the nearest hit within the length and its geom are mj_ray's."""
     grid, _ = arena_sims()
     rng = np.random.default_rng(100 + seed)
@@ -124,7 +125,7 @@ def test_ray_caster_equals_mj_ray(seed):
     direction *= rng.uniform(0.2, 3.0, (count, 1)) / np.linalg.norm(direction, axis=1, keepdims=True)
     rays = Rays(origin, direction, rng.uniform(0.0, 1.5, count), grid.robot_bodies[robot])
     geomid = np.zeros(1, np.int32)
-    for group in (None, np.array([1, 0, 0, 0, 0, 0], np.uint8)):
+    for group in (None, (np.arange(6) == COLLISION_GROUP).astype(np.uint8)):
         dist, geom = grid.rays.cast(rays, group)
         for k in range(count):
             ref = mujoco.mj_ray(m, d, origin[k], direction[k], group, 1, int(rays.exclude_body[k]), geomid)
@@ -157,10 +158,11 @@ def test_bearing_line_of_sight_equals_mj_ray():
     poses = grid.poses()
     fast = grid.sight(k, p)
     geomid = np.zeros(1, np.int32)
+    collision = (np.arange(6) == COLLISION_GROUP).astype(np.uint8)
     for i, j, seen in zip(k, p, fast):
         start = np.array([poses[i, 0], poses[i, 1], 0.06])
         vec = np.array([poses[j, 0] - poses[i, 0], poses[j, 1] - poses[i, 1], 0.0])
-        mujoco.mj_ray(grid.model, grid.data, start, vec, np.array([1, 0, 0, 0, 0, 0], np.uint8), 1,
+        mujoco.mj_ray(grid.model, grid.data, start, vec, collision, 1,
                       int(grid.robot_bodies[i]), geomid)
         assert seen == (geomid[0] >= 0 and grid.geom_robot[geomid[0]] == j)
     assert fast.any() and not fast.all()

@@ -4,7 +4,7 @@ Modelled on an omnidirectional IR beacon receiver with robot identification (eac
 robot's beacon is modulated with its id): robot ``k`` sees robot ``p`` when ``p`` is within
 ``range_m`` and inside the field of view ``|beta| <= fov_rad`` around ``k``'s heading, and
 nothing blocks the line of sight (:mod:`mjswarm.core.sight`: a ray from ``k``'s centre towards
-``p`` hits ``p`` first; only collision geoms, group 0, block: walls and robots).
+``p`` hits ``p`` first; only collision geoms block: robots, walls, the floor).
 The reading is ``beta_kp``: the angle from ``k``'s heading to ``p`` (rad, CCW positive),
 plus optional Gaussian noise. Defaults: +-60 degrees, 1 m.
 

@@ -1,7 +1,7 @@
 """Line of sight between robots: cast once per world state, shared by every sensor.
 
 Robot ``k`` sees robot ``p`` when a ray from ``k``'s centre at ``RAY_HEIGHT_M``, towards
-``p``'s centre, hits ``p`` first; only collision geoms (group 0: walls and robots) block.
+``p``'s centre, hits ``p`` first; only collision geoms (``COLLISION_GROUP``: robots, walls, the floor) block.
 The bearing sensor (:mod:`mjswarm.core.bearing`) asks this for the ordered pairs in its field of
 view, the radio (:func:`mjswarm.experiments.awareness.sight_blocker`) for both directions of every
 pair in range. :class:`LineOfSight` answers each ordered pair once per world state (the
@@ -18,12 +18,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from mjswarm.core.raycast import Rays
+from mjswarm.core.world import COLLISION_GROUP
 
 if TYPE_CHECKING:
     from mjswarm.core.simulation import Simulation
 
 RAY_HEIGHT_M = 0.06  # above the wheels (0.05 m), inside the chassis (0.012..0.07 m)
-_GROUP0 = np.array([1, 0, 0, 0, 0, 0], dtype=np.uint8)
+#: ``mj_ray``'s group filter: only collision geoms block line of sight.
+_COLLISION = (np.arange(6) == COLLISION_GROUP).astype(np.uint8)
 
 
 class LineOfSight:
@@ -77,5 +79,5 @@ class LineOfSight:
         unit[~apart, 0] = 1.0
         start = np.column_stack([poses[k, :2], np.full(len(k), RAY_HEIGHT_M)])
         self.rays_cast += len(k)
-        _, geom = sim.rays.cast(Rays(start, unit, dist + sim.rays.robot_radius_m, sim.robot_bodies[k]), _GROUP0)
+        _, geom = sim.rays.cast(Rays(start, unit, dist + sim.rays.robot_radius_m, sim.robot_bodies[k]), _COLLISION)
         return apart & (geom >= 0) & (sim.geom_robot[geom] == p)

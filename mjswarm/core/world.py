@@ -4,9 +4,10 @@ Everything is assembled with :class:`mujoco.MjSpec`: the robot template (see
 :mod:`mjswarm.core.robot`) is attached once per robot with the name prefix ``r<i>/``, so robot
 ``i``'s sensors are ``r<i>/line_left`` ... and its actuators ``r<i>/wheel_left`` ...
 
-Floor marks (line strips) are thin boxes in geom group 3 with ``contype = conaffinity
-= 0``: the rangefinders see them (rays test every group) but the wheels never touch
-them. Walls are collision boxes in group 0. The arena builder
+Geom groups follow mujoco_menagerie (``models/spark_v.xml``): collision geoms (robots'
+bodies, walls, the floor) in ``COLLISION_GROUP`` 3, visual-only geoms in 2. Floor marks
+(line strips) are thin boxes in ``STRIP_GROUP`` 1 with ``contype = conaffinity = 0``: the
+rangefinders see them (rays test every group) but the wheels never touch them. The arena builder
 (:mod:`mjswarm.arena.builder`) turns a graph spec into these primitives; tests and the
 benchmark use them directly.
 """
@@ -25,7 +26,10 @@ from mjswarm.core.robot import DEFAULT_ROBOT_XML, ROOT_BODY, load_robot_spec
 
 #: Physics timestep (s) and integrator used for every world.
 PHYSICS_TIMESTEP_S = 0.002
-STRIP_GROUP = 3
+#: Geom group of everything that collides (robots, walls, floor): what blocks line of sight.
+COLLISION_GROUP = 3
+#: Geom group of the floor marks (line strips).
+STRIP_GROUP = 1
 FLOOR_RGBA = (0.92, 0.92, 0.90, 1.0)
 STRIP_RGBA = (0.05, 0.05, 0.05, 1.0)
 WALL_RGBA = (0.55, 0.35, 0.25, 1.0)
@@ -111,7 +115,7 @@ def world_spec(
     spec.worldbody.add_light(pos=[centre[0], centre[1], 5.0], dir=[0, 0, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL)
     spec.worldbody.add_geom(
         name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, pos=[centre[0], centre[1], 0.0],
-        size=[half[0], half[1], 0.05], rgba=FLOOR_RGBA,
+        size=[half[0], half[1], 0.05], rgba=FLOOR_RGBA, group=COLLISION_GROUP,
     )
     for i, strip in enumerate(strips):
         mid, half_len, yaw = _segment_frame(strip.start, strip.end)
@@ -125,6 +129,7 @@ def world_spec(
         mid, half_len, yaw = _segment_frame(wall.start, wall.end)
         spec.worldbody.add_geom(
             name=f"wall{i}", type=mujoco.mjtGeom.mjGEOM_BOX, rgba=WALL_RGBA,
+            group=COLLISION_GROUP,
             pos=[mid[0], mid[1], wall.height_m / 2.0], quat=yaw_quat(yaw),
             size=[half_len, wall.thickness_m / 2.0, wall.height_m / 2.0],
         )
