@@ -121,7 +121,7 @@ def test_no_working_gl_backend_is_one_line_and_no_file(tmp_path):
                           env=env, capture_output=True, text=True, timeout=300, check=False)
     assert done.returncode == 2
     assert done.stderr.strip().splitlines() == [done.stderr.strip()]
-    assert "no working OpenGL backend (MUJOCO_GL=glx)" in done.stderr
+    assert "no working OpenGL backend (MUJOCO_GL=glx;" in done.stderr
     assert list(tmp_path.iterdir()) == []
 
 

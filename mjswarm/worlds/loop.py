@@ -133,8 +133,9 @@ class World(ABC):
         """Robot ``i``'s messages (radio, then infrastructure) and radio neighbours."""
         inbox, neighbors = ([], frozenset()) if self.radio is None else (
             self.radio.receive(i), self.radio.neighbors(i))
-        for link in self.uplinks.values():
-            inbox += link.receive_for(i)
+        if self.uplinks:
+            for link in self.uplinks.values():
+                inbox += link.receive_for(i)
         return inbox, neighbors
 
     def _send(self, i: int, messages: Sequence[Message]) -> None:
@@ -211,14 +212,17 @@ class Loop:
         world, controllers = self.world, self.controllers
         for f in self.functions:
             f.before_step(self)
-        for i in world.active():
-            if i in self.halted:
-                continue
-            world.act(i, controllers[i].step(world.observe(i)))
-            for f in self._after_act:
-                f.after_act(self, i)
-            if self._stop:
-                break
+        robots = [i for i in world.active() if i not in self.halted]
+        if self._after_act:
+            for i in robots:
+                world.act(i, controllers[i].step(world.observe(i)))
+                for f in self._after_act:
+                    f.after_act(self, i)
+                if self._stop:
+                    break
+        else:  # the same without hooks, which many robots make worth a loop of its own
+            for i in robots:
+                world.act(i, controllers[i].step(world.observe(i)))
         world.step()
         self.ticks += 1
         for f in self.functions:

@@ -44,9 +44,10 @@ class SparkWorld(World):
         self.bearing = bearing
         self.beacon_at = beacon_at
         self.uplinks = {}
-        self._v = np.zeros(self.n)
-        self._w = np.zeros(self.n)
+        self._v = [0.0] * self.n  # commands of this tick, as floats (cheaper than numpy items)
+        self._w = [0.0] * self.n
         self._version = -1
+        self._now_s = 0.0
         self._columns: tuple = ()
         self._bearings: list[dict] | None = None
 
@@ -67,16 +68,16 @@ class SparkWorld(World):
                              r["wheel_speed"].tolist(), r["battery"].tolist())
             self._bearings = self.bearing.read() if self.bearing is not None else None
             self._version = self.sim.state_version
+            self._now_s = self.sim.time_s
         line, ir, encoder, wheel_speed, battery = self._columns
         inbox, neighbors = self._inbox(i)
         return Observation(
-            i, self.sim.time_s, line[i], ir[i], encoder[i], wheel_speed[i], battery[i],
-            bearings=NOTHING if self._bearings is None else self._bearings[i],
-            inbox=inbox, neighbors=neighbors,
-            beacon=None if self.beacon_at is None else self.beacon_at(i))
+            i, self._now_s, line[i], ir[i], encoder[i], wheel_speed[i], battery[i], None,
+            NOTHING if self._bearings is None else self._bearings[i], NOTHING, inbox,
+            neighbors, None if self.beacon_at is None else self.beacon_at(i))
 
     def commanded_speeds(self) -> np.ndarray:
-        return self._v.copy()
+        return np.array(self._v)
 
     def bearing_readings(self) -> list[dict[int, float]]:
         """What every robot's bearing sensor reported at the last observed state (for
@@ -89,7 +90,7 @@ class SparkWorld(World):
             self._send(i, command.messages)
 
     def step(self) -> None:
-        self.sim.set_velocity(self._v, self._w)
+        self.sim.set_velocity(np.array(self._v), np.array(self._w))
         self.sim.step()
         self._radio_step()
 
