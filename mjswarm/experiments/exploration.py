@@ -267,6 +267,9 @@ class EmbodiedExploration(LoopFunctions):
         self.fault_log: list[dict] = []
         self.ended_because = "max time"
         self.agree = self.samples = 0
+        self._truth: dict[int, str] | None = None  # this tick's truth, on sampled ticks
+        self._beliefs: dict[int, str] = {}
+        self._links: list = []
         longest = max(math.dist(spec.vertices[u], spec.vertices[v]) for u, v in spec.edges)
         self.stall_timeout_s = (config.stall_timeout_s if config.stall_timeout_s is not None
                                 else max(STALL_MIN_S, STALL_EDGE_FACTOR * longest / config.speed_m_s))
@@ -348,7 +351,13 @@ class EmbodiedExploration(LoopFunctions):
 
     # ------------------------------------------------------------------ hooks
     def before_step(self, loop: Loop) -> None:
-        """Faults, launches, the stations' mail, grants."""
+        """Faults, launches, the stations' mail, grants; the radio's truth, five times a
+        second."""
+        radio = self.world.radio
+        if radio is not None and self.sim.step_count % 10 == 0 and self.sim.step_count:
+            graph = radio.graph()
+            self._truth = awareness_truth(graph, 0, range(1, len(self.robots)))
+            self._links, self._beliefs = list(graph.edges), {}
         self._inject_faults()
         self._launch_if_free()
         for message in self.uplink.receive():
@@ -367,6 +376,8 @@ class EmbodiedExploration(LoopFunctions):
     def after_act(self, loop: Loop, i: int) -> None:
         """What robot ``i`` did this tick, for the metrics and the recording."""
         robot = self.robots[i]
+        if self._truth is not None and i in self._truth:
+            self._beliefs[i] = self._belief(i)
         nav = robot.nav
         if nav.state is NavigatorState.ON_EDGE:
             self._measure_heading(i)
@@ -382,7 +393,7 @@ class EmbodiedExploration(LoopFunctions):
 
     def after_step(self, loop: Loop) -> None:
         sim = self.sim
-        if self.world.radio is not None and sim.step_count % 10 == 0:
+        if self._truth is not None:
             self._sample_beliefs()
         if self.recorder is not None:
             readings = sim.readings()
@@ -517,17 +528,21 @@ class EmbodiedExploration(LoopFunctions):
         error = abs(math.remainder(self.robots[i].nav.odometry.theta - true_yaw, 2 * math.pi))
         self.heading_error_rad = max(self.heading_error_rad, error)
 
+    def _belief(self, i: int) -> str:
+        return BICONNECTED if self.robots[i].table.is_doubly_connected() else NOT
+
     def _sample_beliefs(self) -> None:
-        """Tables' beliefs against the truth, for R2..RK (R1 is the reference)."""
-        radio = self.world.radio
-        truth = awareness_truth(radio.graph(), 0, range(1, len(self.robots)))
-        beliefs = {i: BICONNECTED if self.robots[i].table.is_doubly_connected() else NOT
-                   for i in truth}
+        """Tables' beliefs against the truth, for R2..RK (R1 is the reference): each
+        robot's belief once its table has seen this tick's links (robots not stepped keep
+        theirs), against the radio graph of this tick."""
+        radio, truth = self.world.radio, self._truth
+        beliefs = {i: self._beliefs.get(i) or self._belief(i) for i in truth}
+        self._truth = None
         self.samples += len(truth)
         self.agree += sum(beliefs[i] == truth[i] for i in truth)
         if self.recorder is not None:
             self.recorder.log_radio(self.sim.step_count, self.sim.time_s,
-                                    [tuple(e) for e in radio.graph().edges], beliefs, truth)
+                                    [tuple(e) for e in self._links], beliefs, truth)
 
     def _inject_faults(self) -> None:
         """Apply the faults whose time has come (:mod:`mjswarm.experiments.faults`), at the control
