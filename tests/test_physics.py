@@ -151,11 +151,11 @@ def test_scene_xml_loads_with_the_worlds_physics_settings():
     import mujoco
 
     from mjswarm.core.robot import MODELS_DIR, spark_v_geometry
-    from mjswarm.core.world import PHYSICS_TIMESTEP_S
+    from mjswarm.core.world import PHYSICS_INTEGRATOR, PHYSICS_TIMESTEP_S
 
     model = mujoco.MjModel.from_xml_path(str(MODELS_DIR / "scene.xml"))
     assert model.opt.timestep == PHYSICS_TIMESTEP_S
-    assert model.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    assert model.opt.integrator == PHYSICS_INTEGRATOR
     assert world_spec([Pose2D(0, 0, 0)]).option.integrator == model.opt.integrator
     assert spark_v_geometry().max_speed_m_s == pytest.approx(0.2)
 
@@ -257,3 +257,22 @@ def test_geom_groups_follow_menagerie():
     assert m.geom_group[names.index("strip0")] == STRIP_GROUP
     assert {"floor", "wall0", "r0/battery", "r0/chassis"} <= {
         n for n, c in zip(names, collides) if c}
+    # models/scene.xml (for the viewer) groups its floor and strip as the worlds do
+    from mjswarm.core.robot import MODELS_DIR
+
+    scene = mujoco.MjModel.from_xml_path(str(MODELS_DIR / "scene.xml"))
+    assert scene.geom("floor").group == COLLISION_GROUP and scene.geom("strip").group == STRIP_GROUP
+    # the groups decide no rangefinder reading (MuJoCo's rangefinders test every group):
+    # the same world with every geom in one group reads the same, bit for bit
+    regrouped = Simulation(world_spec([Pose2D(0, 0, 0)], strips=[FloorStrip((0, 0), (1, 0))],
+                                      walls=[WallSegment((0, 0.3), (1, 0.3))]), sensing="mujoco")
+    regrouped.model.geom_group[:] = 5
+    saw_wall = saw_strip = False
+    for _ in range(150):  # a 0.2 m circle: over the strip, into the wall
+        for s in (sim, regrouped):
+            s.set_velocity(np.full(s.n, 0.1), np.full(s.n, 0.5))
+            s.step()
+        assert sim.readings().tobytes() == regrouped.readings().tobytes()
+        saw_wall |= bool(np.isfinite(sim.readings()["ir"]).any())
+        saw_strip |= bool((sim.readings()["line"] < 0.019).any())
+    assert saw_wall and saw_strip

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import mujoco
 import numpy as np
 
 from mjswarm.core.raycast import Rays
@@ -25,7 +26,7 @@ if TYPE_CHECKING:
 
 RAY_HEIGHT_M = 0.06  # above the wheels (0.05 m), inside the chassis (0.012..0.07 m)
 #: ``mj_ray``'s group filter: only collision geoms block line of sight.
-_COLLISION = (np.arange(6) == COLLISION_GROUP).astype(np.uint8)
+_COLLISION = (np.arange(mujoco.mjNGROUP) == COLLISION_GROUP).astype(np.uint8)
 
 
 class LineOfSight:

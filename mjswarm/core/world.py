@@ -24,8 +24,9 @@ import numpy as np
 from mjswarm.errors import MjswarmError
 from mjswarm.core.robot import DEFAULT_ROBOT_XML, ROOT_BODY, load_robot_spec
 
-#: Physics timestep (s) and integrator used for every world.
+#: Physics timestep (s) and integrator used for every world (``models/scene.xml`` too).
 PHYSICS_TIMESTEP_S = 0.002
+PHYSICS_INTEGRATOR = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
 #: Geom group of everything that collides (robots, walls, floor): what blocks line of sight.
 COLLISION_GROUP = 3
 #: Geom group of the floor marks (line strips).
@@ -102,7 +103,7 @@ def world_spec(
     spec.modelname = "mjswarm_world"
     spec.copy_during_attach = True
     spec.option.timestep = timestep_s
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.option.integrator = PHYSICS_INTEGRATOR
     spec.visual.global_.offwidth = 1280
     spec.visual.global_.offheight = 960
 

@@ -45,6 +45,8 @@ BENCH_SPEED_M_S = 0.1
 RADIO_RANGE_M = 1.0
 #: the line follower's turn rate when one side sensor sees the strip (rad/s)
 TURN_GAIN_RAD_S = 0.8
+#: what every robot broadcasts every tick (a heartbeat carries nothing but its sender)
+HEARTBEAT = (Message("heartbeat"),)
 
 
 @dataclass(frozen=True)
@@ -89,10 +91,9 @@ class BenchRobot(Controller):
     def step(self, observation: Observation) -> Command:
         self.heard += len(observation.inbox)
         line = observation.line_m
-        left = float(self.height_m - line[0] > LINE_THRESHOLD_M)
-        right = float(self.height_m - line[2] > LINE_THRESHOLD_M)
-        return Command(self.rule.update(observation.bearings), TURN_GAIN_RAD_S * (left - right),
-                       messages=(Message(observation.time_s),))
+        turn = (TURN_GAIN_RAD_S if self.height_m - line[0] > LINE_THRESHOLD_M else 0.0) - (
+            TURN_GAIN_RAD_S if self.height_m - line[2] > LINE_THRESHOLD_M else 0.0)
+        return Command(self.rule.update(observation.bearings), turn, None, HEARTBEAT)
 
 
 def bench_loop(sim: Simulation) -> Loop:

@@ -93,7 +93,7 @@ class MujocoCamera:
                                f"(MUJOCO_GL={backend}; MuJoCo reads it when first imported, "
                                f"so set it before importing mujoco): {one_line(exc)}") from None
         self.option = mujoco.MjvOption()
-        self.option.geomgroup[:] = 1  # arena strips live in a group the viewer hides
+        self.option.geomgroup[:] = 1  # the bodies and the floor are collision geoms (group 3)
         self.camera = _overview(mujoco.MjvCamera(), bounds_m, width / height)
 
     def __call__(self, poses, trails, marks) -> np.ndarray:
