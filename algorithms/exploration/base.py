@@ -102,6 +102,14 @@ class Strategy(ABC):
         self.n_robots = n_robots
         self.rng = rng
 
+    def arrive(self, beacon: Beacon, angles: Sequence[float], arrived_by: float | None) -> None:
+        """Bookkeeping of an arrival that must reach the beacon before any robot arriving
+        at the same time decides (Brass et al.'s model for MR-DFS). The graph world calls
+        it for every robot of a simultaneous batch, then :meth:`on_vertex` for each; a
+        strategy that keeps its bookkeeping and decision together leaves it empty (seed
+        003's robots handle simultaneous arrivals one after another, see the module
+        docstring)."""
+
     @abstractmethod
     def on_vertex(
         self, beacon: Beacon, angles: Sequence[float], arrived_by: float | None

@@ -21,8 +21,13 @@ Rules inferred where the paper's text was not available to us:
 * Among unexplored edges: the first counter-clockwise from the edge the robot arrived by
   (+x at the root), as for the proposed method; among explored ones, fewest robots first,
   then the same order. With an ``rng``, these ties are broken at random.
-* Robots processed at a vertex at the same time take distinct unexplored edges, since
-  each sees the counts the previous one left.
+* Robots that arrive at the same time (the graph world) first all record their arrival
+  on the beacons (:meth:`MRDFS.arrive`: parent edge, finished edges), then decide one
+  after another, each seeing the counts the previous one left (so they take distinct
+  unexplored edges): Brass et al.'s bookkeeping devices record every arrival before any
+  robot leaves. Decided in arrival order instead, a robot would not yet know that
+  another had just come in along a cycle edge and would traverse that edge again
+  (issue 16: fig9 with 2 robots 14 instead of 12).
 * The map (for metrics) is built with the incidence matrix like every strategy
   (:mod:`~algorithms.exploration.mapping`); it plays no part in the decisions.
 
@@ -36,6 +41,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from algorithms.exploration.base import DONE, Beacon, Decision, ccw_from
+from algorithms.exploration.incidence_matrix import merge
 from algorithms.exploration.mapping import MapStrategy, VertexRecord
 
 #: What the edge a robot is on means for it when it arrives: going down (exploring or
@@ -61,12 +67,15 @@ class MRDFS(MapStrategy):
     def __init__(self, index, n_robots, rng=None):
         super().__init__(index, n_robots, rng)
         self.mode = DESCENDING
+        self._arrived: DFSRecord | None = None  # recorded by arrive(), not yet decided
+        self._closed_cycle = False
 
-    def on_vertex(
-        self, beacon: Beacon, angles: Sequence[float], arrived_by: float | None
-    ) -> Decision:
+    def arrive(self, beacon: Beacon, angles: Sequence[float], arrived_by: float | None) -> None:
+        """Record the arrival on the beacon: the parent edge of a new vertex, a finished
+        edge; an arrival along a new edge into a known vertex closes a cycle."""
         new = beacon.data is None
         record, _ = self.first_step(beacon, angles, arrived_by)
+        self._closed_cycle = False
         if arrived_by is not None:
             if new:
                 record.parent = self.arrival
@@ -74,7 +83,19 @@ class MRDFS(MapStrategy):
                 record.finished.add(self.arrival)
             elif self.arrival != record.parent:
                 record.finished.add(self.arrival)
-                return self._move(record, self.arrival, FINISHING)
+                self._closed_cycle = True
+        self._arrived = record
+
+    def on_vertex(
+        self, beacon: Beacon, angles: Sequence[float], arrived_by: float | None
+    ) -> Decision:
+        if self._arrived is None:
+            self.arrive(beacon, angles, arrived_by)
+        record, self._arrived = self._arrived, None
+        # arrivals recorded since this robot's own: take their knowledge along
+        self.matrix = record.matrix = merge(self.matrix, record.matrix)
+        if self._closed_cycle:
+            return self._move(record, self.arrival, FINISHING)
         children = [
             a
             for a in ccw_from(self.arrival, self.matrix.rows[self.here])

@@ -188,32 +188,37 @@ class GraphWorld:
         events = [(0, -i) for i in range(k)]
         heapq.heapify(events)
         declared = None
-        while events:
-            t, neg = heapq.heappop(events)
+        while events and declared is None:
+            t = events[0][0]
             if t > max_time:
                 break
-            i = -neg
-            v = position[i]
-            beacon = beacons[v]
-            decision = minds[i].on_vertex(beacon, self.angles[v], arrived_by[i])
-            if beacon.id is not None and beacon.id not in beacon_vertex:
-                beacon_vertex[beacon.id] = v
-            if observer is not None:
-                observer(t, i, v, decision, minds[i])
-            if decision.action == "go":
-                u = self._follow(v, decision.angle)
-                done_at = self._clock(t + self.duration[(v, u)])
-                position[i], arrived_by[i], arrival_time[i] = u, self.angle_of[(u, v)], done_at
-                paths[i].append(u)
-                heapq.heappush(events, (done_at, neg))
-            elif decision.action == "idle":
-                arrived_by[i] = None
-                heapq.heappush(events, (t + 1, neg))
-            elif decision.action == "done":
-                declared = (t, i, v)
-                break
-            else:
-                raise ValueError(f"robot {i + 1} answered an unknown decision {decision!r}")
+            batch = []  # every robot at a vertex at time t, in descending index
+            while events and events[0][0] == t:
+                batch.append(-heapq.heappop(events)[1])
+            for i in batch:  # all bookkeeping first (a no-op for most strategies) ...
+                minds[i].arrive(beacons[position[i]], self.angles[position[i]], arrived_by[i])
+            for i in batch:  # ... then the decisions, one after another
+                v = position[i]
+                beacon = beacons[v]
+                decision = minds[i].on_vertex(beacon, self.angles[v], arrived_by[i])
+                if beacon.id is not None and beacon.id not in beacon_vertex:
+                    beacon_vertex[beacon.id] = v
+                if observer is not None:
+                    observer(t, i, v, decision, minds[i])
+                if decision.action == "go":
+                    u = self._follow(v, decision.angle)
+                    done_at = self._clock(t + self.duration[(v, u)])
+                    position[i], arrived_by[i], arrival_time[i] = u, self.angle_of[(u, v)], done_at
+                    paths[i].append(u)
+                    heapq.heappush(events, (done_at, -i))
+                elif decision.action == "idle":
+                    arrived_by[i] = None
+                    heapq.heappush(events, (t + 1, -i))
+                elif decision.action == "done":
+                    declared = (t, i, v)
+                    break
+                else:
+                    raise ValueError(f"robot {i + 1} answered an unknown decision {decision!r}")
         if declared is not None:
             for j in range(k):  # traversals still under way at the declaration do not count
                 if arrival_time[j] > declared[0]:
