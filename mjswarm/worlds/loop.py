@@ -139,6 +139,10 @@ class World(ABC):
         return inbox, neighbors
 
     def _send(self, i: int, messages: Sequence[Message]) -> None:
+        if self.radio is not None and not self.uplinks:  # the common case, without checks
+            for m in messages:
+                self.radio.send(i, m.payload, m.to)
+            return
         for m in messages:
             if m.to in self.uplinks:
                 self.uplinks[m.to].send(i, m.payload)
@@ -221,8 +225,9 @@ class Loop:
                 if self._stop:
                     break
         else:  # the same without hooks, which many robots make worth a loop of its own
+            observe, act = world.observe, world.act
             for i in robots:
-                world.act(i, controllers[i].step(world.observe(i)))
+                act(i, controllers[i].step(observe(i)))
         world.step()
         self.ticks += 1
         for f in self.functions:
