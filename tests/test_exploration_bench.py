@@ -1,15 +1,15 @@
-"""The graph-world benchmark is callable from code and measures something sane."""
+"""The exploration benchmarks are callable from code and measure something sane."""
 
 from __future__ import annotations
 
 import importlib.util
 from pathlib import Path
 
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "graphworld_bench.py"
+BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
 
 
-def load_bench():
-    spec = importlib.util.spec_from_file_location("graphworld_bench", BENCH)
+def load_bench(name: str = "graphworld_bench"):
+    spec = importlib.util.spec_from_file_location(name, BENCHMARKS / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -22,3 +22,10 @@ def test_bench_reports_runs_per_second(capsys):
     assert 0 < r["runs_per_s_median"] <= r["runs_per_s_best"]
     assert bench.main(["--arena", "fig9", "--robots", "2", "--runs", "2", "--repeats", "1"]) == 0
     assert "runs/s" in capsys.readouterr().out
+
+
+def test_embodied_bench_compares_the_loop_with_bare_physics_of_the_same_run():
+    r = load_bench("exploration_bench").bench("fig9", robots=1, speed_m_s=0.2)
+    assert r["completed"] and r["sim_time_s"] > 10
+    assert r["bare_realtime"] > r["full_realtime"] > 0
+    assert r["overhead_ratio"] == r["full_wall_s"] / r["bare_wall_s"]
