@@ -110,6 +110,7 @@ class Radio:
         self._present: dict[Hashable, None] = dict.fromkeys(self.robots)
         self._neighbors: dict[Hashable, frozenset] = {r: frozenset() for r in self.robots}
         self._ordered: dict[Hashable, tuple] = {r: () for r in self.robots}
+        self._links: np.ndarray | None = None  # the index pairs the two dicts were built from
         self._edges: frozenset[frozenset] | None = None
         self._positions: dict[Hashable, np.ndarray] = {}
         self._outbox: list[tuple[Message, tuple[Hashable, ...]]] = []
@@ -228,15 +229,17 @@ class Radio:
     def _deliver(self) -> None:
         outbox, self._outbox = self._outbox, []
         self.last_batch = len(outbox)
+        present, inbox, received = self._present, self._inbox, self.received
+        lossless = not self.blackout and not self.drop_prob
         for message, recipients in outbox:
             for r in recipients:
-                if r not in self._present:
+                if r not in present:
                     continue
-                if self.blackout or (self.drop_prob and self._rng.random() < self.drop_prob):
+                if not lossless and (self.blackout or self._rng.random() < self.drop_prob):
                     self.dropped += 1
                     continue
-                self._inbox[r].append(message)
-                self.received[r] += 1
+                inbox[r].append(message)
+                received[r] += 1
 
     def _relink(self) -> None:
         if self.range_m is None:
@@ -271,7 +274,11 @@ class Radio:
         return ij
 
     def _set_links(self, ij: np.ndarray) -> None:
-        """Neighbour sets and, per robot, its neighbours in robot order, from index pairs."""
+        """Neighbour sets and, per robot, its neighbours in robot order, from index pairs
+        (kept as they are when the pairs did not change, as between most ticks)."""
+        if self._links is not None and np.array_equal(ij, self._links):
+            return
+        self._links = ij
         src = np.concatenate([ij[:, 0], ij[:, 1]])
         dst = np.concatenate([ij[:, 1], ij[:, 0]])
         order = np.lexsort((dst, src))

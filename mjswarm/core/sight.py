@@ -49,6 +49,13 @@ class LineOfSight:
         if self._version != self.sim.state_version:  # a new state: nothing known yet
             self._version = self.sim.state_version
             self._keys, self._seen = np.empty(0, np.int64), np.empty(0, bool)
+            order = np.argsort(key, kind="stable")
+            if len(key) < 2 or (np.diff(key[order]) > 0).all():  # all new, no repeats
+                self._keys = key[order]
+                self._seen = self._cast(self._keys // n, self._keys % n)
+                seen = np.empty(len(key), bool)
+                seen[order] = self._seen
+                return seen
         where = self._find(key)
         missing = where < 0
         if missing.any():
