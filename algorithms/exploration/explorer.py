@@ -106,9 +106,9 @@ class Explorer(Controller):
 
     def step(self, observation: Observation) -> Command:
         out: list[Message] = []
-        robots = [m for m in observation.inbox if m.sender != STATION]
         if self.table is not None:
             now = round(observation.time_s / self.control_dt_s)
+            robots = [m for m in observation.inbox if m.sender != STATION]
             out += self.table.tick(now, robots, observation.neighbors)
         for m in observation.inbox:
             if m.sender == STATION:

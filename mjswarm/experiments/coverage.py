@@ -173,7 +173,7 @@ class CoverageRun(LoopFunctions):
         self.recording = Recording(recorder) if recorder is not None else None
         self.loop = Loop(self.world, {}, [self] + ([self.recording] if self.recording else [])
                          + list(functions))
-        self._ticks = 0
+        self._ticks, self._running = 0, ""
         for _ in range(START_ROBOTS):
             self._episode("add", -1)
 
@@ -229,7 +229,7 @@ class CoverageRun(LoopFunctions):
         if self.recording is not None:
             self.recording.event(self.loop, f"episode {index}: {action} R{robot + 1}", robot)
         before = {k: (m.moves_led, m.checks_led) for k, m in self.minds.items()}
-        self._ticks = 0
+        self._ticks, self._running = 0, f"episode {index} ({action} robot {robot})"
         self.loop.run()
         moves = sum(m.moves_led - before.get(k, (0, 0))[0] for k, m in self.minds.items())
         checks = sum(m.checks_led - before.get(k, (0, 0))[1] for k, m in self.minds.items())
@@ -245,7 +245,7 @@ class CoverageRun(LoopFunctions):
         if self._settled():
             return True
         if self._ticks >= self.max_ticks:
-            raise MjswarmError(f"episode did not settle within {self.max_ticks} ticks")
+            raise MjswarmError(f"{self._running} did not settle within {self.max_ticks} ticks")
         return False
 
     def result(self, loop: Loop) -> CoverageResult:

@@ -261,6 +261,7 @@ class EmbodiedExploration(LoopFunctions):
         self.last_progress_s = 0.0
         self.declared: tuple[float, int, str] | None = None
         self.stopped: list[dict] = []
+        self._reported: set[int] = set()  # robots in ``stopped``
         self._last_speed = [config.speed_m_s] * k  # for the recording's speed-change events
         self.heading_error_rad = 0.0
         self.pending_faults = sorted(config.faults, key=lambda f: f.at_s)
@@ -275,6 +276,7 @@ class EmbodiedExploration(LoopFunctions):
                                 else max(STALL_MIN_S, STALL_EDGE_FACTOR * longest / config.speed_m_s))
         self._vertices = np.array(list(spec.vertices.values()))
         self._vertex_ids = list(spec.vertices)
+        self._nearest_version = -1  # _nearest_vertex's cache
         for fault in config.faults:
             fault.check(self)
         self.loop = Loop(self.world, dict(enumerate(self.robots)), [self])
@@ -307,7 +309,7 @@ class EmbodiedExploration(LoopFunctions):
         shown = 0
         for _ in range(ticks):
             self.step()
-            if self.finished():
+            if self.loop.stopped:  # should_stop: finished() said why
                 break
             now = int(self.sim.time_s)
             if now > shown:
@@ -384,7 +386,7 @@ class EmbodiedExploration(LoopFunctions):
         for call in robot.calls[self._calls_seen[i]:]:
             self._vertex_call(i, call)
         self._calls_seen[i] = len(robot.calls)
-        if robot.halted is not None and not any(s["robot"] == i + 1 for s in self.stopped):
+        if robot.halted is not None and i not in self._reported:
             self._stopped(i, robot.halted)
         if robot.speed_m_s != self._last_speed[i] and nav.on_lane:
             self._event(i, f"R{i + 1} speed {self._last_speed[i]:.3f} -> "
@@ -502,6 +504,7 @@ class EmbodiedExploration(LoopFunctions):
             self.target[i] = self.stations.edge_towards(vertex, call.decision.angle)[0]
 
     def _stopped(self, i: int, reason: str) -> None:
+        self._reported.add(i)
         self.stopped.append({"robot": i + 1, "reason": reason, "at_s": round(self.sim.time_s, 2)})
         self._event(i, f"R{i + 1} stopped: {reason}")
 
@@ -566,10 +569,17 @@ class EmbodiedExploration(LoopFunctions):
         self.recorder.log_explored_graph(step, now, i, nodes, edges)
 
     def _nearest_vertex(self, i: int) -> tuple[str, float]:
-        """The vertex nearest to robot ``i`` and its distance (m): what the stations see."""
-        d = np.hypot(*(self._vertices - self.sim.poses()[i, :2]).T)
-        j = int(np.argmin(d))
-        return self._vertex_ids[j], float(d[j])
+        """The vertex nearest to robot ``i`` and its distance (m): what the stations see.
+        Every robot's is computed once per world state (each robot's observation asks)."""
+        sim = self.sim
+        if self._nearest_version != sim.state_version:
+            xy = sim.poses()[:, :2]
+            d = np.hypot(xy[:, None, 0] - self._vertices[None, :, 0],
+                         xy[:, None, 1] - self._vertices[None, :, 1])
+            self._nearest = d.argmin(axis=1)
+            self._nearest_m = d[np.arange(len(xy)), self._nearest]
+            self._nearest_version = sim.state_version
+        return self._vertex_ids[self._nearest[i]], float(self._nearest_m[i])
 
     def _event(self, i: int | None, text: str) -> None:
         if self.recorder is not None:

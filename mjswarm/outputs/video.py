@@ -94,6 +94,8 @@ class MujocoCamera:
                                f"so set it before importing mujoco): {one_line(exc)}") from None
         self.option = mujoco.MjvOption()
         self.option.geomgroup[:] = 1  # the bodies and the floor are collision geoms (group 3)
+        # rangefinder rays would be drawn as short yellow strokes, like the beacon marks
+        self.option.flags[mujoco.mjtVisFlag.mjVIS_RANGEFINDER] = 0
         self.camera = _overview(mujoco.MjvCamera(), bounds_m, width / height)
 
     def __call__(self, poses, trails, marks) -> np.ndarray:
