@@ -112,7 +112,7 @@ class Radio:
         self._ordered: dict[Hashable, tuple] = {r: () for r in self.robots}
         self._links: np.ndarray | None = None  # the index pairs the two dicts were built from
         self._edges: frozenset[frozenset] | None = None
-        self._positions: dict[Hashable, np.ndarray] = {}
+        self._xy: np.ndarray | None = None  # positions (metres), one row per robot, in order
         self._outbox: list[tuple[Message, tuple[Hashable, ...]]] = []
         self._inbox: dict[Hashable, list[Message]] = {r: [] for r in self.robots}
         #: transmissions per robot (one per :meth:`send`)
@@ -166,7 +166,7 @@ class Radio:
         """The current radio graph of present robots (node attribute ``pos`` if known)."""
         g = nx.Graph()
         for r in self._present:
-            g.add_node(r, **({"pos": tuple(self._positions[r])} if r in self._positions else {}))
+            g.add_node(r, **({} if self._xy is None else {"pos": tuple(self._xy[self._index[r]])}))
         g.add_edges_from((i, j) for i in self._present for j in self._neighbors[i])
         return g
 
@@ -186,17 +186,30 @@ class Radio:
         self._deliver()
         if positions is not None:
             self.move(positions)
-        elif self.range_m is not None and not self._positions:
+        elif self.range_m is not None and self._xy is None:
             raise MjswarmError("radio: range mode needs positions at the first step")
 
-    def move(self, positions: Mapping[Hashable, Sequence[float]]) -> None:
-        """Range mode: set the robots' positions (metres) and recompute the links now."""
+    def move(self, positions: Mapping[Hashable, Sequence[float]] | np.ndarray) -> None:
+        """Range mode: set the robots' positions (metres) and recompute the links now.
+
+        ``positions`` maps every present robot to its coordinates, or is an array with one
+        row per robot in :attr:`robots` order (rows of absent robots are ignored).
+        """
         if self.range_m is None:
             raise MjswarmError("radio: explicit-edge mode takes no positions")
-        missing = [r for r in self._present if r not in positions]
-        if missing:
-            raise MjswarmError(f"radio: no position for robot {missing[0]!r}")
-        self._positions = {r: np.asarray(positions[r], dtype=float) for r in self._present}
+        if isinstance(positions, np.ndarray):
+            if positions.ndim != 2 or len(positions) != len(self.robots):
+                raise MjswarmError(f"radio: positions of shape {positions.shape} for "
+                                   f"{len(self.robots)} robots")
+            self._xy = positions.astype(float)
+        else:
+            missing = [r for r in self._present if r not in positions]
+            if missing:
+                raise MjswarmError(f"radio: no position for robot {missing[0]!r}")
+            rows = [np.asarray(positions[r], dtype=float) for r in self._present]
+            self._xy = np.full((len(self.robots), len(rows[0]) if rows else 2), np.nan)
+            for r, row in zip(self._present, rows):
+                self._xy[self._index[r]] = row
         self._relink()
 
     def send(self, sender: Hashable, payload: Any, to: Hashable | None = None) -> None:
@@ -251,11 +264,13 @@ class Radio:
 
     def _pairs_in_range(self) -> np.ndarray:
         """Linked pairs in range mode, as robot indices ``(k, l)``, k < l, sorted."""
-        present = list(self._present)
-        if not self._positions or not present:
+        if self._xy is None or not self._present:
             return np.empty((0, 2), dtype=np.intp)
-        xy = np.stack([self._positions[r] for r in present])
-        rows = np.array([self._index[r] for r in present], dtype=np.intp)
+        if len(self._present) == len(self.robots):
+            rows = np.arange(len(self.robots))
+        else:
+            rows = np.array([self._index[r] for r in self._present], dtype=np.intp)
+        xy = self._xy[rows]
         finite = np.isfinite(xy).all(axis=1)
         xy, rows = xy[finite], rows[finite]
         near = cKDTree(xy).query_pairs(

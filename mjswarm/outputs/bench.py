@@ -15,6 +15,9 @@ floor strip, walls beside every row) and measures, in the same process and run:
   model with sensors disabled and constant controls;
 * ``overhead_ratio``: their quotient (physics-only / full), i.e. how many times longer
   a full step takes than bare physics.
+
+The two take turns in ``BLOCKS`` stretches of equal simulated time, so that the machine's
+slow spells (this one is a shared virtual machine) fall on both alike.
 """
 
 from __future__ import annotations
@@ -45,6 +48,8 @@ BENCH_SPEED_M_S = 0.1
 RADIO_RANGE_M = 1.0
 #: the line follower's turn rate when one side sensor sees the strip (rad/s)
 TURN_GAIN_RAD_S = 0.8
+#: stretches in which the full loop and bare physics take turns (:func:`run_bench`)
+BLOCKS = 8
 #: what every robot broadcasts every tick (a heartbeat carries nothing but its sender)
 HEARTBEAT = (Message("heartbeat"),)
 
@@ -107,25 +112,34 @@ def bench_loop(sim: Simulation) -> Loop:
 
 
 def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROBOT_XML),
-              sensing: str = "auto") -> BenchResult:
-    """Measure one robot count over ``sim_seconds`` of simulated time."""
+              sensing: str = "auto", blocks: int = BLOCKS) -> BenchResult:
+    """Measure one robot count over ``sim_seconds`` of simulated time.
+
+    The full loop and bare physics take turns in ``blocks`` equal stretches, so a slow
+    spell of the machine weighs on both alike; each rate is over all its stretches.
+    """
     if sim_seconds <= 0:
         raise MjswarmError(f"benchmark duration must be positive, got {sim_seconds} s")
+    if blocks < 1:
+        raise MjswarmError(f"benchmark blocks must be >= 1, got {blocks}")
     sim = bench_world(n, robot_xml, sensing)
     loop = bench_loop(sim)
     loop.step()  # warm-up: one-time costs (loading the compiled ray loop) stay out of the timing
-    ticks = max(1, round(sim_seconds / sim.control_dt_s))
-    start = time.perf_counter()
-    loop.run(max_ticks=ticks + 1)
-    full_wall = time.perf_counter() - start
-
     bare = bench_world(n, robot_xml)
     m, d = bare.model, bare.data
     m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
     bare.set_velocity(np.full(n, BENCH_SPEED_M_S), np.zeros(n))
-    start = time.perf_counter()
-    mujoco.mj_step(m, d, nstep=ticks * bare.substeps)
-    bare_wall = time.perf_counter() - start
+
+    ticks = max(blocks, round(sim_seconds / sim.control_dt_s))
+    full_wall = bare_wall = 0.0
+    for b in range(blocks):
+        block = ticks * (b + 1) // blocks - ticks * b // blocks
+        start = time.perf_counter()
+        loop.run(max_ticks=loop.ticks + block)
+        full_wall += time.perf_counter() - start
+        start = time.perf_counter()
+        mujoco.mj_step(m, d, nstep=block * bare.substeps)
+        bare_wall += time.perf_counter() - start
 
     simulated = ticks * sim.control_dt_s
     return BenchResult(

@@ -118,9 +118,9 @@ class World(ABC):
         if self.radio is not None and self.radio.range_m is not None:
             self.radio.move(self._air_positions())
 
-    def _air_positions(self) -> dict[int, np.ndarray]:
-        xy = self.true_poses()[:, :2]
-        return {i: xy[i] for i in self.radio.present}
+    def _air_positions(self) -> np.ndarray:
+        """Where the robots are (metres), one row per robot: the radio's robots are 0 .. n - 1."""
+        return self.true_poses()[:, :2]
 
     def _radio_step(self) -> None:
         """End of a tick: deliver this tick's messages, relink from the new positions."""
