@@ -8,6 +8,7 @@ import sys
 
 from tqdm import tqdm
 
+from mjswarm.core.kinematic import PHYSICS
 from mjswarm.errors import MjswarmError
 
 
@@ -42,6 +43,10 @@ def register(subparsers) -> None:
     parser.add_argument("--sensing", choices=("auto", "grid", "mujoco"), default="auto",
                         help="rangefinder implementation: O(N) grid ray casting, MuJoCo's own "
                              "sensors (O(N^2)), or auto (grid from 32 robots; default)")
+    parser.add_argument("--physics", choices=PHYSICS, default="dynamic",
+                        help="the full loop's physics tier: dynamic (MuJoCo's contact physics; "
+                             "default) or kinematic (wheel kinematics, stop at contacts); bare "
+                             "mj_step is dynamic in both, so the ratio says what the tier saves")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
 
@@ -54,17 +59,17 @@ def run(args) -> int:
     model = args.model or str(DEFAULT_ROBOT_XML)
     load_robot_spec(model)  # fail with one line before any progress bar
     results = [
-        as_dict(run_bench(n, args.seconds, model, args.sensing))
+        as_dict(run_bench(n, args.seconds, model, args.sensing, physics=args.physics))
         for n in tqdm(counts, desc="bench", unit="world", disable=None, file=sys.stderr)
     ]
     if args.json:
         print(json.dumps({"machine": _machine(), "results": results}, indent=2))
         return 0
     print(f"machine: {_machine()}")
-    print(f"{'robots':>7} {'sensing':>8} {'realtime':>10} {'physics-only':>13} {'overhead':>9} "
+    print(f"{'robots':>7} {'physics':>9} {'sensing':>8} {'realtime':>10} {'physics-only':>13} {'overhead':>9} "
           f"{'robot-steps/s':>14}")
     for r in results:
-        print(f"{r['robots']:>7} {r['sensing']:>8} {r['realtime_factor']:>9.2f}x "
+        print(f"{r['robots']:>7} {r['physics']:>9} {r['sensing']:>8} {r['realtime_factor']:>9.2f}x "
               f"{r['physics_only_realtime_factor']:>12.2f}x {r['overhead_ratio']:>9.2f} "
               f"{r['robot_steps_per_s']:>14.0f}")
     return 0

@@ -12,7 +12,7 @@ import numpy as np
 
 
 class CollisionCounter:
-    """Counts new touching robot pairs each time :meth:`update` is called.
+    """Counts new touching robot pairs each time :meth:`record` is called.
 
     Args:
         geom_robot: for every geom of the model, the index of the robot it belongs
@@ -36,12 +36,12 @@ class CollisionCounter:
         pairs = np.sort(robots[mask], axis=1)
         return {(int(a), int(b)) for a, b in pairs}
 
-    def update(self, data: mujoco.MjData) -> list[tuple[int, int]]:
-        """Record the pairs that started touching since the last call; return them."""
-        now = self.touching_pairs(data)
+    def record(self, time_s: float, now: set[tuple[int, int]]) -> list[tuple[int, int]]:
+        """Record which pairs ``(i, j)``, i < j, touch at ``time_s`` (s); return the new ones
+        (the kinematic tier reports its pairs here, :mod:`mjswarm.core.kinematic`)."""
         new = sorted(now - self._touching)
         self._touching = now
-        self.events.extend((float(data.time), i, j) for i, j in new)
+        self.events.extend((time_s, i, j) for i, j in new)
         return new
 
     @property

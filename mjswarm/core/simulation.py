@@ -37,6 +37,7 @@ import numpy as np
 
 from mjswarm.core.battery import Battery
 from mjswarm.core.contacts import CollisionCounter
+from mjswarm.core.kinematic import PHYSICS, KinematicDrive
 from mjswarm.errors import MjswarmError, one_line
 from mjswarm.core.raycast import RayCaster, Rays
 from mjswarm.core.robot import (
@@ -86,6 +87,10 @@ class Simulation:
         wheel_slip: wheel slip seen by the encoders: each control tick, each wheel's
             encoder advances by its true rotation times ``1 + |n|``, ``n ~ N(0,
             wheel_slip)`` (the wheel spun that much more than it rolled); 0 by default.
+        physics: ``"dynamic"`` (MuJoCo's contact physics, the default) or ``"kinematic"``
+            (robots move by their wheel kinematics and stop at contacts, no constraint
+            solve: :mod:`mjswarm.core.kinematic`); the kinematic tier always senses with
+            the ray caster (``sensing`` ``"auto"`` or ``"grid"``).
     """
 
     def __init__(
@@ -97,6 +102,7 @@ class Simulation:
         ir_noise_m: float = 0.0,
         sensing: str = "auto",
         wheel_slip: float = 0.0,
+        physics: str = "dynamic",
     ) -> None:
         if control_hz <= 0:
             raise MjswarmError(f"control rate must be positive, got {control_hz} Hz")
@@ -106,6 +112,11 @@ class Simulation:
             raise MjswarmError(f"wheel slip must be in [0, 1), got {wheel_slip}")
         if sensing not in SENSING:
             raise MjswarmError(f"sensing must be one of {', '.join(SENSING)}, got '{sensing}'")
+        if physics not in PHYSICS:
+            raise MjswarmError(f"physics must be one of {', '.join(PHYSICS)}, got '{physics}'")
+        if physics == "kinematic" and sensing == "mujoco":
+            raise MjswarmError("the kinematic tier senses with the ray caster: use sensing "
+                               "'grid' or 'auto' with physics 'kinematic'")
         try:
             self.model = spec.compile()
         except ValueError as exc:
@@ -154,7 +165,9 @@ class Simulation:
         if self.n == 0:
             raise MjswarmError("a simulation needs at least one robot")
         if sensing == "auto":
-            sensing = "grid" if self.n >= GRID_SENSING_MIN_ROBOTS else "mujoco"
+            kinematic = physics == "kinematic"
+            sensing = "grid" if kinematic or self.n >= GRID_SENSING_MIN_ROBOTS else "mujoco"
+        self.physics = physics
         self.sensing = sensing
         self.geometry = measure_geometry(m, "r0/")
         self.collisions = CollisionCounter(geom_robot)
@@ -172,6 +185,8 @@ class Simulation:
             mujoco.mj_kinematics(m, self.data)
         # a world grid sensing cannot cast fails here, in one line
         self._rays = RayCaster(m, self.data, self.robot_bodies, geom_robot) if sensing == "grid" else None
+        self._drive = KinematicDrive(self) if physics == "kinematic" else None
+        self._no_torque = np.zeros((self.n, 2))
         self._sense_now()
 
     @property
@@ -250,29 +265,40 @@ class Simulation:
 
     def _sense_now(self) -> None:
         """Recompute kinematics (and MuJoCo's sensors, if on) and read every sensor."""
-        mujoco.mj_forward(self.model, self.data)
+        if self._drive is not None:  # nothing to solve: positions are all there is
+            mujoco.mj_kinematics(self.model, self.data)
+        else:
+            mujoco.mj_forward(self.model, self.data)
         self.state_version += 1
         self._wheels = self._wheel_state()
         self._readings = self._read_sensors()
 
     # ------------------------------------------------------------------ stepping
     def step(self, ticks: int = 1) -> None:
-        """Advance ``ticks`` control periods (each ``substeps`` physics steps)."""
+        """Advance ``ticks`` control periods (each ``substeps`` physics steps, or one
+        kinematic tick of as long in the kinematic tier)."""
         m, d = self.model, self.data
         sensor_bit = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
         for _ in range(ticks):
-            if self.substeps > 1:
-                m.opt.disableflags |= sensor_bit
-                mujoco.mj_step(m, d, nstep=self.substeps - 1)
-                if self.sensing == "mujoco":
-                    m.opt.disableflags &= ~sensor_bit
-            if self.sensing == "grid":
-                self._wheels = self._wheel_state()  # the state the last step's sensors see
-            mujoco.mj_step(m, d)
+            if self._drive is not None:
+                touching = self._drive.step(self.substeps)
+                self._wheels = self._wheel_state()
+                torque = self._no_torque
+            else:
+                if self.substeps > 1:
+                    m.opt.disableflags |= sensor_bit
+                    mujoco.mj_step(m, d, nstep=self.substeps - 1)
+                    if self.sensing == "mujoco":
+                        m.opt.disableflags &= ~sensor_bit
+                if self.sensing == "grid":
+                    self._wheels = self._wheel_state()  # the state the last step's sensors see
+                mujoco.mj_step(m, d)
+                touching = self.collisions.touching_pairs(d)
+                torque = d.actuator_force[self._actuators]
             self.step_count += 1
             self.state_version += 1
-            self.battery.update(d.actuator_force[self._actuators], self.control_dt_s)
-            self.collisions.update(d)
+            self.battery.update(torque, self.control_dt_s)
+            self.collisions.record(float(d.time), touching)
             previous = self._readings["encoder"] if self.wheel_slip else None
             self._readings = self._read_sensors()
             if self.wheel_slip:

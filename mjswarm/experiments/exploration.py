@@ -126,6 +126,8 @@ class EmbodiedConfig:
         line_noise_m, ir_noise_m: standard deviation of the line and IR rangefinders'
             Gaussian noise (m).
         wheel_slip: scale of the wheel-slip model (:class:`mjswarm.core.simulation.Simulation`).
+        physics: ``"dynamic"`` (MuJoCo's contact physics) or ``"kinematic"`` (the fast
+            tier, :mod:`mjswarm.core.kinematic`).
     """
 
     speed_m_s: float = PAPER_SPEED_M_S
@@ -145,6 +147,7 @@ class EmbodiedConfig:
     line_noise_m: float = 0.0
     ir_noise_m: float = 0.0
     wheel_slip: float = 0.0
+    physics: str = "dynamic"
 
 
 @dataclass
@@ -217,7 +220,7 @@ class EmbodiedExploration(LoopFunctions):
                  for i in range(k)]
         self.sim = Simulation(arena_world_spec(spec, depot), seed=seed or 0,
                               line_noise_m=config.line_noise_m, ir_noise_m=config.ir_noise_m,
-                              wheel_slip=config.wheel_slip)
+                              wheel_slip=config.wheel_slip, physics=config.physics)
         geometry = self.sim.geometry
         if geometry.max_speed_m_s < config.speed_m_s:
             raise MjswarmError(

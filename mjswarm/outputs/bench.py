@@ -12,7 +12,8 @@ floor strip, walls beside every row) and measures, in the same process and run:
   (:class:`~algorithms.collision.CollisionRule`, bearing rates) setting the speed of a
   line follower that steers from the robot's own line sensors;
 * ``physics_only_realtime_factor``: the same for bare ``mj_step`` on the same compiled
-  model with sensors disabled and constant controls;
+  model with sensors disabled and constant controls (dynamic physics in both tiers: the
+  kinematic tier's ratio is to what it replaces);
 * ``overhead_ratio``: their quotient (physics-only / full), i.e. how many times longer
   a full step takes than bare physics.
 
@@ -59,6 +60,7 @@ class BenchResult:
     """Figures for one robot count (rates in simulated seconds per wall second)."""
 
     robots: int
+    physics: str
     sensing: str
     sim_seconds: float
     realtime_factor: float
@@ -67,7 +69,8 @@ class BenchResult:
     robot_steps_per_s: float
 
 
-def bench_world(n: int, robot_xml: str = str(DEFAULT_ROBOT_XML), sensing: str = "auto") -> Simulation:
+def bench_world(n: int, robot_xml: str = str(DEFAULT_ROBOT_XML), sensing: str = "auto",
+                physics: str = "dynamic") -> Simulation:
     """N robots in a near-square grid, each on a strip with a wall on its left."""
     if n < 1:
         raise MjswarmError(f"robot count must be >= 1, got {n}")
@@ -80,7 +83,8 @@ def bench_world(n: int, robot_xml: str = str(DEFAULT_ROBOT_XML), sensing: str = 
         WallSegment((-0.5, r * ROW_SPACING_M + 0.13), (row_len, r * ROW_SPACING_M + 0.13))
         for r in range(rows)
     ]
-    return Simulation(world_spec(poses, strips, walls, robot_xml=robot_xml), sensing=sensing)
+    return Simulation(world_spec(poses, strips, walls, robot_xml=robot_xml), sensing=sensing,
+                      physics=physics)
 
 
 class BenchRobot(Controller):
@@ -112,8 +116,9 @@ def bench_loop(sim: Simulation) -> Loop:
 
 
 def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROBOT_XML),
-              sensing: str = "auto", blocks: int = BLOCKS) -> BenchResult:
-    """Measure one robot count over ``sim_seconds`` of simulated time.
+              sensing: str = "auto", blocks: int = BLOCKS, physics: str = "dynamic") -> BenchResult:
+    """Measure one robot count over ``sim_seconds`` of simulated time, the full loop in the
+    ``physics`` tier against bare dynamic physics (``mj_step``) of the same world.
 
     The full loop and bare physics take turns in ``blocks`` equal stretches, so a slow
     spell of the machine weighs on both alike; each rate is over all its stretches.
@@ -122,7 +127,7 @@ def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROB
         raise MjswarmError(f"benchmark duration must be positive, got {sim_seconds} s")
     if blocks < 1:
         raise MjswarmError(f"benchmark blocks must be >= 1, got {blocks}")
-    sim = bench_world(n, robot_xml, sensing)
+    sim = bench_world(n, robot_xml, sensing, physics)
     loop = bench_loop(sim)
     loop.step()  # warm-up: one-time costs (loading the compiled ray loop) stay out of the timing
     bare = bench_world(n, robot_xml)
@@ -144,6 +149,7 @@ def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROB
     simulated = ticks * sim.control_dt_s
     return BenchResult(
         robots=n,
+        physics=physics,
         sensing=sim.sensing,
         sim_seconds=simulated,
         realtime_factor=simulated / full_wall,

@@ -1,0 +1,254 @@
+"""The kinematic tier: robots move by their wheels' kinematics; MuJoCo keeps the scene.
+
+``Simulation(physics="kinematic")`` keeps the same compiled scene, arena and sensors as the
+dynamic tier, but no constraint is solved: each control tick :class:`KinematicDrive`
+
+1. runs the wheels' motor filter exactly as the model declares it (``filterexact`` with the
+   actuator's time constant ``tau``: ``a <- a + (u - a)(1 - exp(-h / tau))`` per physics step
+   ``h``, ``u`` the commanded wheel speed clamped to the ctrl range) and takes each wheel's
+   speed equal to its filtered set-point (the velocity servo is ideal: no lag, no slip);
+2. integrates differential-drive kinematics per physics step, ``v = r (w_l + w_r) / 2``,
+   ``omega = r (w_r - w_l) / b`` (``r`` wheel radius, ``b`` track, both from the model), the
+   heading at the step's midpoint (second order; the error over a 2 ms step is below 1e-9 m);
+3. applies the contact rule below, writes the poses, wheel angles (the encoders) and
+   velocities into ``data`` and recomputes kinematics (``mj_kinematics``), so the ray
+   caster, the bearing sensor, the radio and the viewer see the new state.
+
+**Contact rule.** In plan every robot is its chassis disc (radius and offset from the
+model's ``chassis`` geom; every other collision geom of the robot lies inside it, which
+``tests/test_kinematic.py`` checks) and every wall is its box's rectangle. A robot whose
+move this tick would make it overlap another robot or a wall more than it did before the
+tick (by more than ``OVERLAP_TOL_M``) stops: it keeps its pose from the start of the tick,
+its wheels stand (the encoders do not advance), its motor filter runs on. The test repeats
+on the new poses until no robot is stopped anew (a stopped robot may block one that moved
+into the place it kept); it ends because the start-of-tick poses pass it. Two robots that
+drive into each other both stop. A robot-robot pair that would have overlapped, or still
+overlaps, is a touching pair: :class:`~mjswarm.core.contacts.CollisionCounter` counts a
+contact event when a pair starts touching, as in the dynamic tier. Bodies never pass
+through each other; robots never push each other or tip.
+
+What this tier leaves out: wheel slip on the floor (the encoders' slip model,
+``Simulation(wheel_slip=...)``, applies in both tiers), the servo's lag behind its
+set-point (about 6 ms at this model's gains), pitching and sinking into the floor, and the
+battery's load current (the wheels need no torque: the battery draws its idle current).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import mujoco
+import numpy as np
+from numba import njit
+from scipy.spatial import cKDTree
+
+from mjswarm.errors import MjswarmError
+
+if TYPE_CHECKING:
+    from mjswarm.core.simulation import Simulation
+
+#: The physics tiers: ``"dynamic"``, MuJoCo's contact physics; ``"kinematic"``, this module.
+PHYSICS = ("dynamic", "kinematic")
+#: Overlap (m) a move may add before the contact rule stops the robot (float rounding).
+OVERLAP_TOL_M = 1e-9
+#: Length (m) of the pieces walls are cut into to find the robots near them.
+WALL_PIECE_M = 0.5
+#: The chassis geom whose disc is a robot's footprint in plan.
+FOOTPRINT_GEOM = "chassis"
+
+
+class KinematicDrive:
+    """Moves a simulation's robots by their wheel kinematics (module docstring)."""
+
+    def __init__(self, sim: Simulation) -> None:
+        m, d = sim.model, sim.data
+        self.sim = sim
+        g = sim.geometry
+        self.wheel_radius_m, self.track_m = g.wheel_radius_m, g.track_m
+        act = sim._actuators
+        if not np.all(m.actuator_dyntype[act] == mujoco.mjtDyn.mjDYN_FILTEREXACT):
+            raise MjswarmError("the kinematic tier needs the wheels' motors to be "
+                               "first-order filters (dyntype filterexact)")
+        self._act_adr = m.actuator_actadr[act]
+        self._ctrl_lo = m.actuator_ctrlrange[act][..., 0]
+        self._ctrl_hi = m.actuator_ctrlrange[act][..., 1]
+        h = m.opt.timestep
+        self._blend = 1.0 - np.exp(-h / m.actuator_dynprm[act][..., 0])
+        self.timestep_s = h
+        chassis = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, f"r0/{FOOTPRINT_GEOM}")
+        if chassis < 0:
+            raise MjswarmError(f"the kinematic tier needs a '{FOOTPRINT_GEOM}' geom on every robot")
+        self.footprint_radius_m = float(m.geom_size[chassis, 0])
+        self._footprint_offset = m.geom_pos[chassis, :2].copy()  # in the robot's frame (m)
+        self._walls = _wall_rectangles(m, d, sim.geom_robot)
+        if self._walls is not None:  # walls cut into pieces for the search of nearby robots
+            centre, axes, half = self._walls
+            count = np.maximum(1, np.ceil(2.0 * half[:, 0] / WALL_PIECE_M)).astype(int)
+            self._piece_wall = np.repeat(np.arange(len(count)), count)
+            along = (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count) + 0.5)
+            offset = (along / count[self._piece_wall] * 2.0 - 1.0) * half[self._piece_wall, 0]
+            self._pieces = cKDTree(centre[self._piece_wall] + offset[:, None] * axes[self._piece_wall, 0])
+            self._piece_reach_m = float(np.hypot(WALL_PIECE_M / 2.0, half[:, 1].max())
+                                        + self.footprint_radius_m)
+        qpos_adr = sim._qpos_adr
+        self._xy_adr = qpos_adr[:, None] + np.arange(2)
+        self._quat_adr = qpos_adr[:, None] + np.arange(3, 7)
+        dof = m.jnt_dofadr[m.body_jntadr[sim.robot_bodies]]
+        self._lin_dof = dof[:, None] + np.arange(2)
+        self._yaw_dof = dof + 5
+
+    # ------------------------------------------------------------------ one tick
+    def step(self, substeps: int) -> set[tuple[int, int]]:
+        """Advance one control tick of ``substeps`` physics steps; the touching pairs."""
+        sim, d = self.sim, self.sim.data
+        start = sim.poses()
+        ctrl = np.clip(d.ctrl[sim._actuators], self._ctrl_lo, self._ctrl_hi)
+        act = d.act[self._act_adr]
+        end, turned, wheel, act = _integrate(start, act, ctrl, self._blend, substeps,
+                                             self.timestep_s, self.wheel_radius_m, self.track_m)
+        stopped, touching = self._contact_rule(start, end)
+        end[stopped] = start[stopped]
+        turned[stopped] = 0.0
+        wheel = np.where(stopped[:, None], 0.0, wheel)
+        self._write(end, turned, wheel, act)
+        d.time += substeps * self.timestep_s
+        mujoco.mj_kinematics(sim.model, d)
+        return touching
+
+    def _write(self, pose: np.ndarray, turned: np.ndarray, wheel: np.ndarray,
+               act: np.ndarray) -> None:
+        sim, d = self.sim, self.sim.data
+        q, qv = d.qpos, d.qvel
+        q[self._xy_adr] = pose[:, :2]
+        half = pose[:, 2] / 2.0
+        quat = np.zeros((len(pose), 4))
+        quat[:, 0], quat[:, 3] = np.cos(half), np.sin(half)
+        q[self._quat_adr] = quat
+        q[sim._wheel_qpos_adr] += turned
+        qv[sim._wheel_dof_adr] = wheel
+        r = self.wheel_radius_m
+        v = r * (wheel[:, 0] + wheel[:, 1]) / 2.0
+        qv[self._lin_dof] = np.column_stack([v * np.cos(pose[:, 2]), v * np.sin(pose[:, 2])])
+        qv[self._yaw_dof] = r * (wheel[:, 1] - wheel[:, 0]) / self.track_m
+        d.act[self._act_adr] = act
+
+    # ------------------------------------------------------------------ contacts
+    def footprints(self, pose: np.ndarray) -> np.ndarray:
+        """Centres (m) of the robots' footprint discs at planar poses ``pose`` (N, 3)."""
+        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+        ox, oy = self._footprint_offset
+        return np.column_stack([pose[:, 0] + c * ox - s * oy, pose[:, 1] + s * ox + c * oy])
+
+    def _contact_rule(self, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, set]:
+        """Which robots stop, and the robot pairs that touch (module docstring)."""
+        before = self.footprints(start)
+        after = self.footprints(end)
+        stopped = np.zeros(len(start), bool)
+        touching: set[tuple[int, int]] = set()
+        centres = after
+        while True:
+            pairs, deeper = self._robot_overlaps(before, centres)
+            touching.update(map(tuple, pairs[deeper].tolist()))
+            anew = np.zeros(len(start), bool)
+            anew[pairs[deeper].ravel()] = True
+            anew |= self._wall_overlaps(before, centres)
+            anew &= ~stopped
+            if not anew.any():
+                break
+            stopped |= anew
+            centres = np.where(stopped[:, None], before, after)
+        touching.update(map(tuple, pairs.tolist()))  # what still overlaps at the final poses
+        return stopped, touching
+
+    def _robot_overlaps(self, before: np.ndarray, now: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Robot pairs ``(i, j)``, i < j, whose discs overlap now, and whether each
+        overlaps more than before the tick."""
+        reach = 2.0 * self.footprint_radius_m
+        pairs = cKDTree(now).query_pairs(reach, output_type="ndarray").reshape(-1, 2)
+        pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+        gap_now = np.linalg.norm(now[pairs[:, 0]] - now[pairs[:, 1]], axis=1)
+        gap_before = np.linalg.norm(before[pairs[:, 0]] - before[pairs[:, 1]], axis=1)
+        depth_now, depth_before = reach - gap_now, reach - gap_before
+        overlap = depth_now > 0.0
+        deeper = depth_now > np.maximum(depth_before, 0.0) + OVERLAP_TOL_M
+        return pairs[overlap], deeper[overlap]
+
+    def _wall_overlaps(self, before: np.ndarray, now: np.ndarray) -> np.ndarray:
+        """Robots whose disc overlaps a wall now more than before the tick."""
+        hit = np.zeros(len(now), bool)
+        if self._walls is None:
+            return hit
+        centre, axes, half = self._walls
+        near = cKDTree(now).sparse_distance_matrix(self._pieces, self._piece_reach_m,
+                                                   output_type="ndarray")
+        pair = np.unique(self._piece_wall[near["j"]] * len(now) + near["i"])
+        wall, robot = np.divmod(pair, len(now))
+        depth_now = self._wall_depth(now[robot], centre[wall], axes[wall], half[wall])
+        depth_before = self._wall_depth(before[robot], centre[wall], axes[wall], half[wall])
+        hit[robot[depth_now > np.maximum(depth_before, 0.0) + OVERLAP_TOL_M]] = True
+        return hit
+
+    def _wall_depth(self, discs: np.ndarray, centre: np.ndarray, axes: np.ndarray,
+                    half: np.ndarray) -> np.ndarray:
+        """How far (m) each disc reaches into its rectangle (negative: the gap); one
+        rectangle (centre, unit axes as rows, half sizes) per disc."""
+        local = np.abs(np.einsum("kij,kj->ki", axes, discs - centre)) - half
+        outside = np.hypot(np.maximum(local[:, 0], 0.0), np.maximum(local[:, 1], 0.0))
+        inside = np.minimum(local.max(axis=1), 0.0)
+        return self.footprint_radius_m - (outside + inside)
+
+
+def _wall_rectangles(m: mujoco.MjModel, d: mujoco.MjData,
+                     geom_robot: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The plan rectangles of the static colliding boxes (walls): centres (W, 2), unit
+    axes (W, 2, 2) and half sizes (W, 2), all in metres; None without walls. Planes (the
+    floor) bound nothing in plan; any other static colliding geom, or a tilted box, is
+    not supported and raises :class:`MjswarmError` naming it."""
+    static = np.flatnonzero((geom_robot < 0) & ((m.geom_contype != 0) | (m.geom_conaffinity != 0)))
+    boxes = []
+    for g in static:
+        kind = int(m.geom_type[g])
+        if kind == mujoco.mjtGeom.mjGEOM_PLANE:
+            continue
+        name = m.geom(g).name or f"geom {g}"
+        if kind != mujoco.mjtGeom.mjGEOM_BOX:
+            raise MjswarmError(f"the kinematic tier supports walls that are boxes; "
+                               f"'{name}' is a {mujoco.mjtGeom(kind).name}")
+        mat = d.geom_xmat[g].reshape(3, 3)
+        if not math.isclose(abs(mat[2, 2]), 1.0, abs_tol=1e-9):
+            raise MjswarmError(f"the kinematic tier needs upright walls; '{name}' is tilted")
+        boxes.append(g)
+    if not boxes:
+        return None
+    mats = d.geom_xmat[boxes].reshape(-1, 3, 3)
+    axes = mats[:, :2, :2].transpose(0, 2, 1)  # rows: the box's x and y axes in the world
+    return d.geom_xpos[boxes, :2].copy(), axes.copy(), m.geom_size[boxes, :2].copy()
+
+
+@njit(cache=True)
+def _integrate(start, act, ctrl, blend, substeps, h, r, b):  # pragma: no cover (compiled)
+    """Steps 1-2 of the module docstring for every robot: the end poses (N, 3), each
+    wheel's turn (rad) and speed in the last step (rad/s), and the motor filter states."""
+    n = start.shape[0]
+    end = start.copy()
+    turned = np.zeros((n, 2))
+    wheel = act.copy()
+    act = act.copy()
+    for i in range(n):
+        x, y, yaw = start[i, 0], start[i, 1], start[i, 2]
+        for _ in range(substeps):
+            left, right = act[i, 0], act[i, 1]
+            v = r * (left + right) / 2.0
+            omega = r * (right - left) / b
+            mid = yaw + omega * (h / 2.0)
+            x += v * h * math.cos(mid)
+            y += v * h * math.sin(mid)
+            yaw += omega * h
+            turned[i, 0] += left * h
+            turned[i, 1] += right * h
+            wheel[i, 0], wheel[i, 1] = left, right
+            act[i, 0] += (ctrl[i, 0] - left) * blend[i, 0]
+            act[i, 1] += (ctrl[i, 1] - right) * blend[i, 1]
+        end[i, 0], end[i, 1], end[i, 2] = x, y, yaw
+    return end, turned, wheel, act
