@@ -17,17 +17,26 @@ from mjswarm.core.kinematic import PHYSICS
 from mjswarm.core.robot import spark_v_geometry
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.graphworld import EDGE_TIMES, GraphWorld
+from mjswarm.worlds.radiograph import CONNECTIVITY
 
 
 def run_graph(args) -> dict:
     """One run in the graph world; the JSON-ready result (see ``ExplorationResult``)."""
     from mjswarm.arena import load_arena
 
+    from mjswarm.worlds.graphworld import make_minds
+    from mjswarm.worlds.radiograph import RadioGraphWorld
+
     spec = load_arena(args.arena)
     world = GraphWorld(spec.graph(), args.root or spec.root, edge_time=args.edge_time or "unit")
-    result = world.explore(
-        args.robots, args.strategy, seed=args.seed, max_time=args.max_time, arena=spec.name
-    )
+    if args.radio_range is None:
+        result = world.explore(
+            args.robots, args.strategy, seed=args.seed, max_time=args.max_time, arena=spec.name
+        )
+    else:
+        radio = RadioGraphWorld(world, args.radio_range, args.connectivity or "none")
+        result = radio.run(make_minds(args.strategy, args.robots, args.seed), seed=args.seed,
+                           max_time=args.max_time, arena=spec.name)
     return {"world": "graph", **result.to_dict()}
 
 
@@ -127,6 +136,18 @@ def register(subparsers) -> None:
     parser.add_argument("--seed", type=int, default=None, metavar="S",
                         help="randomise tie-breaking with this seed (default: the "
                              "strategies' fixed tie rules)")
+    parser.add_argument("--connectivity", default=None, choices=CONNECTIVITY,
+                        help="none: explore as seed 003 (default); connected: every robot "
+                             "keeps a radio route to the base at the root (needs "
+                             "--radio-range; graph world only so far); a team that cannot "
+                             "go on says so (infeasible) and stops")
+    parser.add_argument("--radio-range", type=float, default=None, metavar="M",
+                        help="radio range, m. Graph world: robots and a base at the root "
+                             "talk within it (walls ignored), and the result reports "
+                             "messages and the share of time every robot had a route to "
+                             "the base. Embodied world: walls block; the robots keep "
+                             "connectivity tables (seed 004) while they move and the result "
+                             "reports how often their beliefs matched the truth")
     parser.add_argument("--max-time", type=float, default=None, metavar="T",
                         help="give up after T: graph world time units (default: "
                              "50 (E + 1) + 100); embodied simulated seconds (default: 3600)")
@@ -149,10 +170,6 @@ def register(subparsers) -> None:
     embodied.add_argument("--launch-order", default=None, metavar="I,J,...",
                           help="order in which robots R1..RK are put on the root, e.g. "
                                "3,1,2 (default: 1,2,...)")
-    embodied.add_argument("--radio-range", type=float, default=None, metavar="M",
-                          help="give the robots radios of this range (m, walls block) and "
-                               "let them keep connectivity tables (seed 004) while they move; "
-                               "reports messages and how often beliefs matched the truth")
     embodied.add_argument("--stall-timeout", type=float, default=None, metavar="S",
                           help="end the run, not completed, when no robot has reached a vertex "
                                "for S simulated seconds (default: 300 s, or 10x the time to "
@@ -186,7 +203,7 @@ def register(subparsers) -> None:
 EMBODIED_ONLY = {
     "speed": "--speed", "no_collision_avoidance": "--no-collision-avoidance",
     "launch_interval": "--launch-interval", "launch_order": "--launch-order",
-    "radio_range": "--radio-range", "stall_timeout": "--stall-timeout", "fault": "--fault",
+    "stall_timeout": "--stall-timeout", "fault": "--fault",
     "line_noise": "--line-noise", "ir_noise": "--ir-noise", "wheel_slip": "--wheel-slip",
     "physics": "--physics",
     "record": "--record", "video": "--video", "video_speed": "--video-speed",
@@ -204,6 +221,14 @@ def check_options(args) -> None:
                                "(--world embodied)")
     elif args.edge_time is not None:
         raise MjswarmError("--edge-time only applies to the graph world (--world graph)")
+    if args.connectivity not in (None, "none"):
+        if args.world != "graph":
+            raise MjswarmError(f"--connectivity {args.connectivity} runs in the graph world "
+                               "only so far (--world graph)")
+        if args.radio_range is None:
+            raise MjswarmError(f"--connectivity {args.connectivity} needs --radio-range")
+    if args.radio_range is not None and not args.radio_range > 0:
+        raise MjswarmError(f"--radio-range must be positive, got {args.radio_range:g} m")
     if args.max_time is not None and not args.max_time > 0:
         raise MjswarmError(f"--max-time must be positive, got {args.max_time:g}")
     if args.launch_interval is not None and not args.launch_interval >= 0:
@@ -225,9 +250,14 @@ def summary(result: dict) -> str:
     """Human-readable lines for one run."""
     head = (f"{result['arena']}: {result['robots']} robot(s), {result['strategy']}, "
             f"{result['world']} world, root {result['root']}")
+    radio = []
+    if result.get("connectivity") is not None:
+        radio = [f"radio {result['radio_range_m']:g} m, connectivity {result['connectivity']}: "
+                 f"{result['messages']} messages; every robot reached the base in "
+                 f"{100 * result['connected_share']:.1f} % of the ticks"]
     if not result["completed"]:
-        why = result.get("ended_because", "max time")
-        lines = [head, f"not completed ({why}): no robot declared completion"]
+        why = result.get("reason") or result.get("ended_because", "max time")
+        lines = [head, f"not completed ({why}): no robot declared completion", *radio]
         lines += [f"stopped: R{s['robot']} at {s['at_s']:.1f} s: {s['reason']}"
                   for s in result.get("stopped_robots", [])]
         return "\n".join(lines)
@@ -240,6 +270,7 @@ def summary(result: dict) -> str:
         f"makespan {result['makespan']:g} {unit}",
         f"traversals: {result['total_traversals']} in total ({per_robot})",
         f"map: {len(result['map_edges'])} edges, {verdict} the arena's",
+        *radio,
     ]
     if result["world"] == "embodied":
         lines += [

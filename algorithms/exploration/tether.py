@@ -1,0 +1,200 @@
+"""Exploration that stays connected: the tether every robot keeps to the base (issue 17).
+
+Seed 003 explores without communication limits; seeds 001, 002 and 004 keep a team
+connected but do not explore. Here each robot explores with its seed-003 strategy while it
+keeps a radio route to the base station at the root. The strategy decides where to go;
+the tether only gates and delays moves. Every rule below is ours (the seeds give none for
+this combination):
+
+1. **Tether.** Every robot has a *parent*: the base or a robot within radio range. The
+   parent relation is a tree rooted at the base.
+2. **Holding** (seed 001's repeater role). A robot with children does not move: it relays.
+   Its children are the robots whose last beat named it as parent, and those it adopted
+   in the last ``ADOPT_GRACE_TICKS`` ticks (their first beat naming it is on its way).
+3. **Leash.** A robot without children takes a step only if, after the step, its parent
+   is within range ``R - margin`` of it. It knows where its radio neighbours are relative
+   to itself (a range-and-bearing sensor, as seed 001's robots have) and what its own
+   step will be. Parents hold and the base never moves, so every tree link survives every
+   tick, and nobody is ever cut off from the base.
+4. **Adoption, make before break.** A robot without children whose step the leash forbids
+   asks one still neighbour (or the base) that would allow the step to adopt it: the
+   fewest tree hops from the base first, then the nearest. So does one that sees a still
+   neighbour fewer hops from the base than its parent is (so that relays are released).
+   The asked robot adds it to its children at once, which makes it hold, and answers
+   ``Adopted``. The asker does not move while its request is out and switches parent only
+   when the answer comes and the new parent is still in range. While its own request is
+   out a robot refuses requests, so simultaneous requests cannot close a cycle. A robot
+   without children has no descendants, so no other request can close one either.
+5. **Stall, and infeasibility.** Every beat carries the latest time at which its sender
+   knows that any robot moved. The team is connected, so the newest time reaches
+   everybody. A robot that knows of no move for ``STALL_TIME_UNITS`` declares the
+   exploration infeasible: nobody can move, so no beacon changes, no strategy changes its
+   mind, and nobody will ever move again.
+
+This module is the robot side: pure Python, no simulator. :mod:`mjswarm.worlds.radiograph`
+runs it in a graph world with a radio and checks the tree against ground truth every
+tick.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Hashable, Mapping, Sequence
+from typing import NamedTuple
+
+from algorithms.robot import Message
+
+#: Ticks a fresh adoption holds the parent before the child's beats must name it
+#: (request, answer and the first beat naming the parent: one tick each, plus one).
+ADOPT_GRACE_TICKS = 4
+#: Time units without any move anywhere after which a robot declares a stall (rule 5).
+STALL_TIME_UNITS = 5.0
+#: Name of the base station on the radio.
+BASE = "base"
+
+
+class Beat(NamedTuple):
+    """Sent by every robot every tick: its parent, its hops from the base, whether it
+    stood still in its last tick, and the latest time at which it knows any robot moved."""
+
+    parent: Hashable | None
+    depth: int
+    still: bool
+    last_move: float
+
+
+class Adopt(NamedTuple):
+    """A request to the robot it is addressed to: be my parent."""
+
+
+class Adopted(NamedTuple):
+    """The answer to :class:`Adopt`: the new parent's hops from the base."""
+
+    depth: int
+
+
+class Tether:
+    """One robot's tether (module docstring).
+
+    Args:
+        me: this robot's radio id.
+        range_m: the radio range R (m).
+        margin_m: the leash keeps the parent within ``R - margin_m``.
+        ticks_per_unit: control ticks per time unit (for the stall rule).
+    """
+
+    def __init__(self, me: Hashable, range_m: float, margin_m: float = 0.0,
+                 ticks_per_unit: int = 10) -> None:
+        self.me = me
+        self.leash_m = range_m - margin_m
+        self.stall_ticks = math.ceil(STALL_TIME_UNITS * ticks_per_unit)
+        self.parent: Hashable = BASE
+        self.depth = 1
+        self.adopted: dict[Hashable, int] = {}  # child -> tick of adoption
+        self.children: set[Hashable] = set()
+        self.request: tuple[Hashable, int] | None = None  # (asked robot, tick asked)
+        self.heard: dict[Hashable, Beat] = {}
+        self.last_move = 0  # tick
+        self.moved = False
+
+    @property
+    def holding(self) -> bool:
+        return bool(self.children)
+
+    # -------------------------------------------------------------- one tick
+    def hear(self, tick: int, inbox: Sequence[Message],
+             around: Mapping[Hashable, Sequence[float]]) -> list[Message]:
+        """Rules 1, 2 and the answering side of 4: read this tick's messages; ``around``:
+        where the radio neighbours are, relative to this robot (m)."""
+        out: list[Message] = []
+        self.heard = {}
+        answer: tuple[Hashable, int] | None = None
+        for m in inbox:
+            p = m.payload
+            if isinstance(p, Beat):
+                self.heard[m.sender] = p
+                self.last_move = max(self.last_move, p.last_move)
+            elif isinstance(p, Adopt) and self.request is None:
+                self.adopted[m.sender] = tick
+                out.append(Message(Adopted(self.depth), to=m.sender))
+            elif isinstance(p, Adopted) and self.request is not None and m.sender == self.request[0]:
+                answer = (m.sender, p.depth)
+        if answer is not None:
+            self.request = None
+            if self._within((0.0, 0.0), around.get(answer[0])):  # the parent holds from now
+                self.parent, self.depth = answer[0], answer[1] + 1
+        elif self.request is not None and tick - self.request[1] > 2:
+            self.request = None  # no answer: the request or its answer did not arrive
+        if self.parent in self.heard:
+            self.depth = self.heard[self.parent].depth + 1
+        self.adopted = {c: t for c, t in self.adopted.items() if tick - t <= ADOPT_GRACE_TICKS}
+        self.children = set(self.adopted) | {c for c, b in self.heard.items()
+                                             if b.parent == self.me}
+        return out
+
+    def may_step(self, step: Sequence[float], around: Mapping[Hashable, Sequence[float]]) -> bool:
+        """Rule 3: whether to take ``step`` (m, this robot's displacement) given where its
+        radio neighbours are relative to it (m)."""
+        if self.children or self.request is not None:
+            return False
+        return self._within(step, around.get(self.parent))
+
+    def ask(self, tick: int, step: Sequence[float] | None,
+            around: Mapping[Hashable, Sequence[float]]) -> list[Message]:
+        """Rule 4, asking side: after a tick in which this robot wanted to take ``step``
+        (None: it wanted to stay) and did not, or could do with a parent nearer the base."""
+        if self.children or self.request is not None:
+            return []
+        parent_depth = self.heard[self.parent].depth if self.parent in self.heard else math.inf
+        best = None
+        for r, beat in self.heard.items():
+            if r == self.parent or not beat.still or r not in around:
+                continue
+            if step is not None and self._within(step, around[r]):
+                key = (beat.depth, math.hypot(*around[r]))
+            elif beat.depth < parent_depth and self._within((0.0, 0.0), around[r]):
+                key = (beat.depth, math.hypot(*around[r]))
+            else:
+                continue
+            if best is None or key < best[0]:
+                best = (key, r)
+        if best is None:
+            return []
+        self.request = (best[1], tick)
+        return [Message(Adopt(), to=best[1])]
+
+    def beat(self, tick: int, moved: bool) -> Message:
+        """Rule 5's gossip, and what the others need of rules 2 and 4."""
+        if moved:
+            self.last_move = tick
+        return Message(Beat(self.parent, self.depth, not moved, self.last_move))
+
+    def stalled(self, tick: int) -> bool:
+        """Rule 5: no move known anywhere for ``STALL_TIME_UNITS``."""
+        return tick - self.last_move >= self.stall_ticks
+
+    # -------------------------------------------------------------- internals
+    def _within(self, step: Sequence[float], offset: Sequence[float] | None) -> bool:
+        """Whether a robot at ``offset`` (m, relative to here) is within the leash after
+        ``step``."""
+        if offset is None:
+            return False
+        return math.hypot(offset[0] - step[0], offset[1] - step[1]) <= self.leash_m
+
+
+class BaseStation:
+    """The base at the root: never moves, adopts every robot that asks, gossips the last
+    move it knows of (rule 5)."""
+
+    def __init__(self) -> None:
+        self.last_move = 0
+
+    def step(self, inbox: Sequence[Message]) -> list[Message]:
+        out = []
+        for m in inbox:
+            if isinstance(m.payload, Beat):
+                self.last_move = max(self.last_move, m.payload.last_move)
+            elif isinstance(m.payload, Adopt):
+                out.append(Message(Adopted(0), to=m.sender))
+        out.append(Message(Beat(None, 0, True, self.last_move)))
+        return out

@@ -1,0 +1,210 @@
+"""The graph world with a radio: seed 003 exploration under a connectivity constraint.
+
+Time runs in ticks of ``1 / TICKS_PER_UNIT`` time units. A robot crosses an edge in its
+duration (one time unit, or proportional to its length: ``edge_time`` as in
+:class:`~mjswarm.worlds.graphworld.GraphWorld`) at constant speed along the straight
+segment between the vertices' positions (metres), unless it waits. The base station stands
+at the root. Radio links join robots, and the base, within ``radio_range_m`` of each other
+(:class:`~mjswarm.core.radio.Radio`: one tick latency, every message counted).
+
+``connectivity``:
+
+* ``"none"``: seed 003 unchanged (robots never wait; no messages).
+* ``"connected"``: each robot keeps its tether (:mod:`algorithms.exploration.tether`).
+
+One tick, for every robot in descending index (the order of seed 003's Fig. 9 run):
+
+1. deliver the radio, and let every robot and the base read its messages;
+2. robots that reached a vertex in the last tick (and idle robots whose time unit is up)
+   let their strategy decide, all bookkeeping first, as in the graph world;
+3. every robot that wants to move asks its tether whether it may take its step; the steps
+   are taken together;
+4. robots that wanted to move and could not, or could use a parent nearer the base, ask
+   for adoption; every robot beats;
+5. ground truth (loop functions only): the radio graph of the base and the robots, with
+   networkx, counts the ticks in which some robot has no route to the base.
+
+The run ends when a robot declares completion, when a robot declares a stall (rule 5 of
+the tether: the result is ``infeasible``, with the explored share of the true edges), or
+at ``max_time``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import networkx as nx
+import numpy as np
+
+from algorithms.exploration import Beacon, Strategy
+from algorithms.exploration.base import angle_gap
+from algorithms.exploration.tether import BASE, BaseStation, Tether
+from mjswarm.core.radio import Radio
+from mjswarm.errors import MjswarmError
+from mjswarm.worlds.graphworld import ExplorationResult, GraphWorld, outcome
+
+CONNECTIVITY = ("none", "connected")
+#: Control ticks per time unit (one edge in the unit-time graph world).
+TICKS_PER_UNIT = 10
+
+
+@dataclass
+class ConnectedExplorationResult(ExplorationResult):
+    """An exploration under a connectivity constraint (times in time units).
+
+    Attributes (beyond :class:`~mjswarm.worlds.graphworld.ExplorationResult`'s):
+        connectivity: the constraint.
+        radio_range_m: the radio range (m).
+        messages: radio transmissions, base included.
+        connected_share: share of ticks in which every robot had a route to the base
+            (ground truth).
+        cut_ticks: ticks in which some robot had none.
+        infeasible: whether the team declared that it cannot go on.
+        reason: why, with the explored share of the true edges; None otherwise.
+    """
+
+    connectivity: str = "none"
+    radio_range_m: float = math.inf
+    messages: int = 0
+    connected_share: float = 1.0
+    cut_ticks: int = 0
+    infeasible: bool = False
+    reason: str | None = None
+
+
+class RadioGraphWorld:
+    """A :class:`~mjswarm.worlds.graphworld.GraphWorld`'s graph, with positions, time in
+    ticks, a base at the root and a radio of range ``radio_range_m`` (m)."""
+
+    def __init__(self, world: GraphWorld, radio_range_m: float, connectivity: str = "connected"):
+        if connectivity not in CONNECTIVITY:
+            raise MjswarmError(f"connectivity must be one of {', '.join(CONNECTIVITY)}, "
+                               f"got '{connectivity}'")
+        if not (math.isfinite(radio_range_m) and radio_range_m > 0):
+            raise MjswarmError(f"radio range must be a positive number of metres, got {radio_range_m}")
+        self.world = world
+        self.range_m = radio_range_m
+        self.connectivity = connectivity
+        self.pos = {v: np.array(p, float) for v, p in world.graph.nodes(data="pos")}
+
+    def run(self, minds: list[Strategy], *, seed: int | None = None,
+            max_time: float | None = None, arena: str = "<graph>") -> ConnectedExplorationResult:
+        """Explore with ``minds`` (one per robot) from the root (module docstring)."""
+        w, k = self.world, len(minds)
+        if max_time is None:
+            max_time = 50 * (len(w.edges) + 1) + 100
+        constrained = self.connectivity == "connected"
+        beacons = {v: Beacon() for v in w.graph}
+        beacon_vertex: dict[str, str] = {}
+        at: list[str | None] = [w.root] * k  # vertex, or None on an edge
+        edge: list[tuple[str, str] | None] = [None] * k
+        progress = [0.0] * k  # share of the edge done
+        xy = np.array([self.pos[w.root]] * k + [self.pos[w.root]])  # robots, then the base
+        arrived_by: list[float | None] = [None] * k
+        wake = [0] * k  # tick at which a robot at a vertex decides
+        paths = [[w.root] for _ in range(k)]
+        ids = list(range(k)) + [BASE]
+        radio = Radio(ids, range_m=self.range_m)
+        radio.move(xy)
+        tethers = [Tether(i, self.range_m, ticks_per_unit=TICKS_PER_UNIT) for i in range(k)]
+        base = BaseStation()
+        declared = infeasible = None
+        cut = ticks = 0
+        order = range(k - 1, -1, -1)
+        last_tick = math.floor(max_time * TICKS_PER_UNIT)
+        while declared is None and infeasible is None and ticks < last_tick:
+            tick = ticks = ticks + 1
+            now = tick / TICKS_PER_UNIT
+            radio.step(xy)
+            around = [self._around(radio, i, xy) for i in range(k)]
+            if constrained:
+                for i in order:
+                    for m in tethers[i].hear(tick, radio.receive(i), around[i]):
+                        radio.send(i, m.payload, m.to)
+                for m in base.step(radio.receive(BASE)):
+                    radio.send(BASE, m.payload, m.to)
+            deciding = [i for i in order if at[i] is not None and wake[i] <= tick]
+            for i in deciding:  # bookkeeping first, then decisions (graph world)
+                minds[i].arrive(beacons[at[i]], w.angles[at[i]], arrived_by[i])
+            for i in deciding:
+                v = at[i]
+                decision = minds[i].on_vertex(beacons[v], w.angles[v], arrived_by[i])
+                if beacons[v].id is not None and beacons[v].id not in beacon_vertex:
+                    beacon_vertex[beacons[v].id] = v
+                if decision.action == "go":
+                    u = self._follow(v, decision.angle)
+                    at[i], edge[i], progress[i], arrived_by[i] = None, (v, u), 0.0, w.angle_of[(u, v)]
+                elif decision.action == "idle":
+                    arrived_by[i], wake[i] = None, tick + TICKS_PER_UNIT
+                elif decision.action == "done":
+                    declared = (now, i, v)
+                    break
+                else:
+                    raise ValueError(f"robot {i + 1} answered an unknown decision {decision!r}")
+            if declared is not None:
+                break
+            steps = {i: self._step(edge[i], progress[i]) for i in order if edge[i] is not None}
+            moved = {i: not constrained or tethers[i].may_step(steps[i], around[i]) for i in steps}
+            for i, go in moved.items():
+                if not go:
+                    continue
+                v, u = edge[i]
+                progress[i] += 1.0 / (w.duration[(v, u)] * TICKS_PER_UNIT)
+                if progress[i] >= 1.0 - 1e-9:
+                    at[i], edge[i], wake[i] = u, None, tick + 1
+                    paths[i].append(u)
+                    xy[i] = self.pos[u]
+                else:
+                    xy[i] = self.pos[v] + progress[i] * (self.pos[u] - self.pos[v])
+            if constrained:
+                radio.move(xy)
+                after = [self._around(radio, i, xy) for i in range(k)]
+                for i in order:
+                    stuck = i in moved and not moved[i]
+                    want = steps[i] if stuck else None
+                    for m in tethers[i].ask(tick, want, after[i]):
+                        radio.send(i, m.payload, m.to)
+                    m = tethers[i].beat(tick, moved.get(i, False))
+                    radio.send(i, m.payload, m.to)
+                if any(t.stalled(tick) for t in tethers):
+                    infeasible = tick
+            cut += not self._all_connected(xy)
+        completed_at = None if declared is None else declared[0]
+        fields = outcome(minds, declared, completed_at, paths, beacon_vertex, w.edges,
+                         arena=arena, root=w.root, edge_time=w.edge_time, seed=seed)
+        reason = None
+        if infeasible is not None:
+            explored = {tuple(sorted(e)) for p in paths for e in zip(p, p[1:])}
+            reason = (f"infeasible with {k} robots at range {self.range_m:g} m: explored "
+                      f"{len(explored)} of {len(w.edges)} edges")
+        return ConnectedExplorationResult(
+            **fields, connectivity=self.connectivity, radio_range_m=self.range_m,
+            messages=radio.total_sent, connected_share=1.0 - cut / max(ticks, 1),
+            cut_ticks=cut, infeasible=infeasible is not None, reason=reason)
+
+    def _follow(self, vertex: str, angle: float) -> str:
+        """The neighbour along the edge at ``vertex`` nearest to ``angle``."""
+        w = self.world
+        return w.towards[(vertex, min(w.angles[vertex], key=lambda a: angle_gap(a, angle)))]
+
+    def _step(self, e: tuple[str, str], progress: float) -> tuple[float, float]:
+        """The displacement (m) a robot on edge ``e`` makes in one tick."""
+        v, u = e
+        share = min(1.0 / (self.world.duration[e] * TICKS_PER_UNIT), 1.0 - progress)
+        d = share * (self.pos[u] - self.pos[v])
+        return float(d[0]), float(d[1])
+
+    def _around(self, radio: Radio, i: int, xy: np.ndarray) -> dict:
+        """Robot ``i``'s range-and-bearing sensing of its radio neighbours (m, relative)."""
+        here = xy[i]
+        return {r: tuple(xy[len(xy) - 1 if r == BASE else r] - here) for r in radio.neighbors(i)}
+
+    def _all_connected(self, xy: np.ndarray) -> bool:
+        """Ground truth: every robot has a radio route to the base (networkx)."""
+        g = nx.Graph()
+        n = len(xy)
+        g.add_nodes_from(range(n))
+        d2 = ((xy[:, None] - xy[None]) ** 2).sum(axis=-1)
+        g.add_edges_from(zip(*np.nonzero(np.triu(d2 <= self.range_m**2, 1))))
+        return nx.is_connected(g)

@@ -1,0 +1,135 @@
+"""Exploration that stays connected (issue 17): the tether rules, the radio graph world's
+ground-truth check, infeasibility, and the CLI."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from algorithms.exploration.tether import BASE, Adopt, Adopted, Beat, Tether
+from algorithms.robot import Message
+from mjswarm.arena import load_arena
+from mjswarm.cli import main
+from mjswarm.errors import MjswarmError
+from mjswarm.worlds.graphworld import GraphWorld, make_minds
+from mjswarm.worlds.radiograph import TICKS_PER_UNIT, RadioGraphWorld
+
+
+def run(arena: str, robots: int, range_m: float, connectivity: str = "connected",
+        strategy: str = "incidence-dfs", seed: int | None = None):
+    spec = load_arena(arena)
+    world = GraphWorld(spec.graph(), spec.root)
+    radio = RadioGraphWorld(world, range_m, connectivity)
+    return radio.run(make_minds(strategy, robots, seed), seed=seed, arena=arena), world
+
+
+CASES = [(f"random-graph:{v}:{e}:{s}", k, r)
+         for s, (v, e) in enumerate([(8, 10), (10, 13), (12, 16), (9, 12), (14, 20)])
+         for k in (2, 4, 6) for r in (0.7, 1.3, 2.5)]
+CASES += [(f"random-tree:{e}:{s}", k, r) for s, e in enumerate((8, 12, 16))
+          for k in (3, 5) for r in (0.9, 1.8)]
+
+
+@pytest.mark.parametrize("arena,robots,range_m", CASES)
+def test_no_robot_is_ever_cut_off_and_every_run_ends_by_a_verdict(arena, robots, range_m):
+    """Ground truth (networkx, every tick): with ``connected`` every robot always has a
+    route to the base; the run ends by completion with the true map or by a declared
+    stall, never at the time limit."""
+    result, world = run(arena, robots, range_m)
+    assert result.cut_ticks == 0 and result.connected_share == 1.0
+    assert result.completed != result.infeasible
+    if result.completed:
+        assert result.map_correct
+    else:
+        assert result.reason.startswith(f"infeasible with {robots} robots at range {range_m:g} m")
+    assert result.messages > 0
+
+
+def test_the_check_has_teeth_unconstrained_robots_get_cut_off():
+    cut = [run(a, k, r, "none")[0].cut_ticks for a, k, r in CASES if r == 0.7]
+    assert len(cut) == 15 and all(c > 0 for c in cut)
+
+
+@pytest.mark.parametrize("arena,robots", [("lattice:5x5", 4), ("arena2", 4), ("fig9", 2),
+                                          ("random-graph:12:16:3", 5)])
+def test_a_range_beyond_the_arena_changes_nothing(arena, robots):
+    """With every robot always in range of the base the leash never binds: the same
+    paths as without the constraint."""
+    free, _ = run(arena, robots, 100.0, "none")
+    tied, _ = run(arena, robots, 100.0, "connected")
+    assert tied.completed and tied.map_correct
+    assert (tied.paths, tied.makespan) == (free.paths, free.makespan)
+    assert tied.cut_ticks == free.cut_ticks == 0
+
+
+def test_too_few_robots_for_the_range_is_reported_infeasible_before_the_time_limit():
+    result, world = run("lattice:5x5", 2, 0.7)
+    assert result.infeasible and not result.completed
+    assert result.reason.startswith("infeasible with 2 robots at range 0.7 m: explored ")
+    assert result.reason.endswith(" of 40 edges")
+
+
+# ---------------------------------------------------------------------------- the tether
+def test_the_leash_keeps_the_parent_in_range():
+    t = Tether(0, range_m=1.0)
+    t.hear(1, [Message(Beat(None, 0, True, 0), sender=BASE)], {BASE: (-0.9, 0.0)})
+    assert t.may_step((0.05, 0.0), {BASE: (-0.9, 0.0)})
+    assert not t.may_step((0.15, 0.0), {BASE: (-0.9, 0.0)})
+
+
+def test_a_robot_with_children_holds():
+    t = Tether(1, range_m=1.0)
+    out = t.hear(5, [Message(Adopt(), to=1, sender=2)], {2: (0.5, 0.0)})
+    assert out == [Message(Adopted(1), to=2)]
+    assert t.holding and not t.may_step((0.0, 0.0), {BASE: (0.1, 0.0)})
+    # the child's beats name another parent and the grace is over: released
+    t.hear(5 + 5, [Message(Beat(BASE, 1, True, 9), sender=2)], {2: (0.5, 0.0)})
+    assert not t.holding
+
+
+def test_crossing_requests_adopt_nobody():
+    """Two robots asking each other at once both refuse: no cycle can close."""
+    a, b = Tether(1, range_m=1.0), Tether(2, range_m=1.0)
+    for t, other in ((a, 2), (b, 1)):
+        t.hear(1, [Message(Beat(BASE, 1, True, 0), sender=other)], {other: (0.3, 0.0)})
+        assert t.ask(1, (0.2, 0.0), {other: (0.3, 0.0)}) == [Message(Adopt(), to=other)]
+    assert a.hear(2, [Message(Adopt(), to=1, sender=2)], {2: (0.3, 0.0)}) == []
+    assert b.hear(2, [Message(Adopt(), to=2, sender=1)], {1: (0.3, 0.0)}) == []
+    assert not a.holding and not b.holding
+
+
+def test_stall_after_the_stated_time():
+    t = Tether(0, range_m=1.0, ticks_per_unit=TICKS_PER_UNIT)
+    t.beat(3, moved=True)
+    assert not t.stalled(3 + 49) and t.stalled(3 + 50)
+
+
+# ---------------------------------------------------------------------------- the CLI
+def test_cli_reports_the_constraint(tmp_path, capsys):
+    out = tmp_path / "r.json"
+    code = main(["explore", "--world", "graph", "--arena", "lattice:5x5", "--robots", "2",
+                 "--radio-range", "0.7", "--connectivity", "connected", "--json", str(out)])
+    result = json.loads(out.read_text())
+    assert code == 1 and result["infeasible"] and result["cut_ticks"] == 0
+    assert main(["explore", "--world", "graph", "--arena", "fig9", "--robots", "2",
+                 "--radio-range", "50", "--connectivity", "connected"]) == 0
+    assert "every robot reached the base in 100.0 % of the ticks" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--connectivity", "connected", "--world", "graph"], "needs --radio-range"),
+    (["--connectivity", "connected", "--radio-range", "1", "--world", "embodied"],
+     "graph world only so far"),
+    (["--radio-range", "-1", "--world", "graph"], "--radio-range must be positive"),
+])
+def test_cli_bad_input_is_one_line(capsys, argv, message):
+    assert main(["explore", "--arena", "fig9", "--robots", "2", *argv]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1
+
+
+def test_bad_connectivity_is_one_clear_error():
+    spec = load_arena("fig9")
+    with pytest.raises(MjswarmError, match="connectivity must be one of none, connected"):
+        RadioGraphWorld(GraphWorld(spec.graph(), spec.root), 1.0, "biconnected")
