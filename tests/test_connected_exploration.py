@@ -7,7 +7,8 @@ import json
 
 import pytest
 
-from algorithms.exploration.tether import BASE, Adopt, Adopted, Beat, Tether
+from algorithms.exploration.tether import (BASE, STALL_TIME_UNITS, STALL_UNITS_PER_EDGE,
+                                           Adopt, Adopted, Beat, Tether)
 from algorithms.robot import Message
 from mjswarm.arena import load_arena
 from mjswarm.cli import main
@@ -70,10 +71,21 @@ def test_too_few_robots_for_the_range_is_reported_infeasible_before_the_time_lim
     assert result.reason.endswith(" of 40 edges")
 
 
+@pytest.mark.parametrize("robots,completes", [(2, False), (4, True)])
+def test_relays_carry_the_team_down_a_path_longer_than_the_range(robots, completes):
+    """A 3 m path (lattice:1x6), range 1 m: two robots reach 2 m at most (infeasible);
+    four get there, because stuck robots are brought relays (rule 6)."""
+    result, _ = run("lattice:1x6", robots, 1.0)
+    assert result.completed == completes and result.infeasible != completes
+    assert result.cut_ticks == 0
+    if completes:
+        assert result.map_correct and result.relay_trips > 0
+
+
 # ---------------------------------------------------------------------------- the tether
 def test_the_leash_keeps_the_parent_in_range():
     t = Tether(0, range_m=1.0)
-    t.hear(1, [Message(Beat(None, 0, True, 0), sender=BASE)], {BASE: (-0.9, 0.0)})
+    t.hear(1, [Message(Beat(None, 0, True, 0, 0), sender=BASE)], {BASE: (-0.9, 0.0)})
     assert t.may_step((0.05, 0.0), {BASE: (-0.9, 0.0)})
     assert not t.may_step((0.15, 0.0), {BASE: (-0.9, 0.0)})
 
@@ -84,7 +96,7 @@ def test_a_robot_with_children_holds():
     assert out == [Message(Adopted(1), to=2)]
     assert t.holding and not t.may_step((0.0, 0.0), {BASE: (0.1, 0.0)})
     # the child's beats name another parent and the grace is over: released
-    t.hear(5 + 5, [Message(Beat(BASE, 1, True, 9), sender=2)], {2: (0.5, 0.0)})
+    t.hear(5 + 5, [Message(Beat(BASE, 1, True, 9, 0), sender=2)], {2: (0.5, 0.0)})
     assert not t.holding
 
 
@@ -92,7 +104,7 @@ def test_crossing_requests_adopt_nobody():
     """Two robots asking each other at once both refuse: no cycle can close."""
     a, b = Tether(1, range_m=1.0), Tether(2, range_m=1.0)
     for t, other in ((a, 2), (b, 1)):
-        t.hear(1, [Message(Beat(BASE, 1, True, 0), sender=other)], {other: (0.3, 0.0)})
+        t.hear(1, [Message(Beat(BASE, 1, True, 0, 0), sender=other)], {other: (0.3, 0.0)})
         assert t.ask(1, (0.2, 0.0), {other: (0.3, 0.0)}) == [Message(Adopt(), to=other)]
     assert a.hear(2, [Message(Adopt(), to=1, sender=2)], {2: (0.3, 0.0)}) == []
     assert b.hear(2, [Message(Adopt(), to=2, sender=1)], {1: (0.3, 0.0)}) == []
@@ -100,9 +112,13 @@ def test_crossing_requests_adopt_nobody():
 
 
 def test_stall_after_the_stated_time():
+    """Rule 5: patience STALL_TIME_UNITS + STALL_UNITS_PER_EDGE per known edge."""
     t = Tether(0, range_m=1.0, ticks_per_unit=TICKS_PER_UNIT)
-    t.beat(3, moved=True)
-    assert not t.stalled(3 + 49) and t.stalled(3 + 50)
+    t.beat(3, moved=True, progressed=True, known_edges=2)
+    patience = round((STALL_TIME_UNITS + 2 * STALL_UNITS_PER_EDGE) * TICKS_PER_UNIT)
+    assert not t.stalled(3 + patience - 1) and t.stalled(3 + patience)
+    t.hear(3 + patience, [Message(Beat(BASE, 1, False, 3 + patience, 5), sender=1)], {})
+    assert not t.stalled(3 + patience)  # news of progress elsewhere
 
 
 # ---------------------------------------------------------------------------- the CLI

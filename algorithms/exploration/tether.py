@@ -19,17 +19,22 @@ this combination):
 4. **Adoption, make before break.** A robot without children whose step the leash forbids
    asks one still neighbour (or the base) that would allow the step to adopt it: the
    fewest tree hops from the base first, then the nearest. So does one that sees a still
-   neighbour fewer hops from the base than its parent is (so that relays are released).
+   neighbour fewer hops from the base than its parent is (so that relays are released);
+   a robot with children may ask the base itself, which descends from nobody.
    The asked robot adds it to its children at once, which makes it hold, and answers
    ``Adopted``. The asker does not move while its request is out and switches parent only
    when the answer comes and the new parent is still in range. While its own request is
    out a robot refuses requests, so simultaneous requests cannot close a cycle. A robot
-   without children has no descendants, so no other request can close one either.
+   without children has no descendants and the base is nobody's, so no other request can
+   close one either.
 5. **Stall, and infeasibility.** Every beat carries the latest time at which its sender
-   knows that any robot moved. The team is connected, so the newest time reaches
-   everybody. A robot that knows of no move for ``STALL_TIME_UNITS`` declares the
-   exploration infeasible: nobody can move, so no beacon changes, no strategy changes its
-   mind, and nobody will ever move again.
+   knows that an exploring robot reached a vertex (so that its strategy decided anew), and
+   the most edges it knows any robot's map to hold. The team is connected, so both reach
+   everybody. A robot that knows of no such arrival for ``STALL_TIME_UNITS`` plus
+   ``STALL_UNITS_PER_EDGE`` time units per known edge declares the exploration infeasible:
+   a relay's round trip (rule 6, :mod:`algorithms.exploration.relay`) crosses each known
+   edge at most twice each way, so past that time nobody is on the way to unblock anybody,
+   no beacon changes, and no strategy changes its mind.
 
 This module is the robot side: pure Python, no simulator. :mod:`mjswarm.worlds.radiograph`
 runs it in a graph world with a radio and checks the tree against ground truth every
@@ -47,20 +52,24 @@ from algorithms.robot import Message
 #: Ticks a fresh adoption holds the parent before the child's beats must name it
 #: (request, answer and the first beat naming the parent: one tick each, plus one).
 ADOPT_GRACE_TICKS = 4
-#: Time units without any move anywhere after which a robot declares a stall (rule 5).
-STALL_TIME_UNITS = 5.0
+#: Time units without an exploring arrival anywhere after which a robot declares a stall
+#: (rule 5), plus ``STALL_UNITS_PER_EDGE`` per edge of the largest known map.
+STALL_TIME_UNITS = 25.0  # longer than rule 6's waits in a row (retreat, reserve, patience)
+STALL_UNITS_PER_EDGE = 4.0
 #: Name of the base station on the radio.
 BASE = "base"
 
 
 class Beat(NamedTuple):
     """Sent by every robot every tick: its parent, its hops from the base, whether it
-    stood still in its last tick, and the latest time at which it knows any robot moved."""
+    stood still in its last tick, the last tick at which it knows an exploring robot
+    reached a vertex, and the most edges it knows a robot's map to hold (rule 5)."""
 
     parent: Hashable | None
     depth: int
     still: bool
-    last_move: float
+    last_progress: int
+    known_edges: int
 
 
 class Adopt(NamedTuple):
@@ -87,15 +96,15 @@ class Tether:
                  ticks_per_unit: int = 10) -> None:
         self.me = me
         self.leash_m = range_m - margin_m
-        self.stall_ticks = math.ceil(STALL_TIME_UNITS * ticks_per_unit)
+        self.ticks_per_unit = ticks_per_unit
         self.parent: Hashable = BASE
         self.depth = 1
         self.adopted: dict[Hashable, int] = {}  # child -> tick of adoption
         self.children: set[Hashable] = set()
         self.request: tuple[Hashable, int] | None = None  # (asked robot, tick asked)
         self.heard: dict[Hashable, Beat] = {}
-        self.last_move = 0  # tick
-        self.moved = False
+        self.last_progress = 0  # tick
+        self.known_edges = 0
 
     @property
     def holding(self) -> bool:
@@ -113,7 +122,8 @@ class Tether:
             p = m.payload
             if isinstance(p, Beat):
                 self.heard[m.sender] = p
-                self.last_move = max(self.last_move, p.last_move)
+                self.last_progress = max(self.last_progress, p.last_progress)
+                self.known_edges = max(self.known_edges, p.known_edges)
             elif isinstance(p, Adopt) and self.request is None:
                 self.adopted[m.sender] = tick
                 out.append(Message(Adopted(self.depth), to=m.sender))
@@ -143,7 +153,12 @@ class Tether:
             around: Mapping[Hashable, Sequence[float]]) -> list[Message]:
         """Rule 4, asking side: after a tick in which this robot wanted to take ``step``
         (None: it wanted to stay) and did not, or could do with a parent nearer the base."""
-        if self.children or self.request is not None:
+        if self.request is not None:
+            return []
+        if self.children:  # a relay may hop straight to the base: it is nobody's descendant
+            if self.parent != BASE and BASE in self.heard and self._within((0.0, 0.0), around.get(BASE)):
+                self.request = (BASE, tick)
+                return [Message(Adopt(), to=BASE)]
             return []
         parent_depth = self.heard[self.parent].depth if self.parent in self.heard else math.inf
         best = None
@@ -163,15 +178,20 @@ class Tether:
         self.request = (best[1], tick)
         return [Message(Adopt(), to=best[1])]
 
-    def beat(self, tick: int, moved: bool) -> Message:
-        """Rule 5's gossip, and what the others need of rules 2 and 4."""
-        if moved:
-            self.last_move = tick
-        return Message(Beat(self.parent, self.depth, not moved, self.last_move))
+    def beat(self, tick: int, moved: bool, progressed: bool, known_edges: int) -> Message:
+        """Rule 5's gossip, and what the others need of rules 2 and 4: ``progressed``
+        when this robot reached a vertex while exploring in this tick, ``known_edges``
+        the edges of its map."""
+        if progressed:
+            self.last_progress = tick
+        self.known_edges = max(self.known_edges, known_edges)
+        return Message(Beat(self.parent, self.depth, not moved, self.last_progress,
+                            self.known_edges))
 
     def stalled(self, tick: int) -> bool:
-        """Rule 5: no move known anywhere for ``STALL_TIME_UNITS``."""
-        return tick - self.last_move >= self.stall_ticks
+        """Rule 5: no exploring arrival known anywhere for the patience it states."""
+        patience = STALL_TIME_UNITS + STALL_UNITS_PER_EDGE * self.known_edges
+        return tick - self.last_progress >= math.ceil(patience * self.ticks_per_unit)
 
     # -------------------------------------------------------------- internals
     def _within(self, step: Sequence[float], offset: Sequence[float] | None) -> bool:
@@ -183,18 +203,24 @@ class Tether:
 
 
 class BaseStation:
-    """The base at the root: never moves, adopts every robot that asks, gossips the last
-    move it knows of (rule 5)."""
+    """The base at the root: never moves, adopts every robot that asks, forwards flooded
+    messages once (``flooder``), and gossips what rule 5 needs."""
 
-    def __init__(self) -> None:
-        self.last_move = 0
+    def __init__(self, flooder) -> None:
+        self.flooder = flooder
+        self.last_progress = 0
+        self.known_edges = 0
 
     def step(self, inbox: Sequence[Message]) -> list[Message]:
         out = []
         for m in inbox:
-            if isinstance(m.payload, Beat):
-                self.last_move = max(self.last_move, m.payload.last_move)
-            elif isinstance(m.payload, Adopt):
+            p = m.payload
+            if isinstance(p, Beat):
+                self.last_progress = max(self.last_progress, p.last_progress)
+                self.known_edges = max(self.known_edges, p.known_edges)
+            elif isinstance(p, Adopt):
                 out.append(Message(Adopted(0), to=m.sender))
-        out.append(Message(Beat(None, 0, True, self.last_move)))
+            elif self.flooder.fresh(p):
+                out.append(Message(p))
+        out.append(Message(Beat(None, 0, True, self.last_progress, self.known_edges)))
         return out

@@ -10,7 +10,9 @@ at the root. Radio links join robots, and the base, within ``radio_range_m`` of 
 ``connectivity``:
 
 * ``"none"``: seed 003 unchanged (robots never wait; no messages).
-* ``"connected"``: each robot keeps its tether (:mod:`algorithms.exploration.tether`).
+* ``"connected"``: each robot keeps its tether (:mod:`algorithms.exploration.tether`) and
+  stuck robots are brought relays (:mod:`algorithms.exploration.relay`); robots walk
+  edges both ways and may stop part-way.
 
 One tick, for every robot in descending index (the order of seed 003's Fig. 9 run):
 
@@ -39,6 +41,7 @@ import numpy as np
 
 from algorithms.exploration import Beacon, Strategy
 from algorithms.exploration.base import angle_gap
+from algorithms.exploration.relay import ConnectedExplorer, Flooder
 from algorithms.exploration.tether import BASE, BaseStation, Tether
 from mjswarm.core.radio import Radio
 from mjswarm.errors import MjswarmError
@@ -60,6 +63,8 @@ class ConnectedExplorationResult(ExplorationResult):
         connected_share: share of ticks in which every robot had a route to the base
             (ground truth).
         cut_ticks: ticks in which some robot had none.
+        relay_trips: relay missions the robots set out on (rule 6 of
+            :mod:`algorithms.exploration.relay`).
         infeasible: whether the team declared that it cannot go on.
         reason: why, with the explored share of the true edges; None otherwise.
     """
@@ -69,6 +74,7 @@ class ConnectedExplorationResult(ExplorationResult):
     messages: int = 0
     connected_share: float = 1.0
     cut_ticks: int = 0
+    relay_trips: int = 0
     infeasible: bool = False
     reason: str | None = None
 
@@ -95,41 +101,41 @@ class RadioGraphWorld:
         if max_time is None:
             max_time = 50 * (len(w.edges) + 1) + 100
         constrained = self.connectivity == "connected"
+        robots = [ConnectedExplorer(i, minds[i], Tether(i, self.range_m,
+                                                        ticks_per_unit=TICKS_PER_UNIT))
+                  for i in range(k)]
+        base = BaseStation(Flooder())
         beacons = {v: Beacon() for v in w.graph}
         beacon_vertex: dict[str, str] = {}
         at: list[str | None] = [w.root] * k  # vertex, or None on an edge
         edge: list[tuple[str, str] | None] = [None] * k
-        progress = [0.0] * k  # share of the edge done
-        xy = np.array([self.pos[w.root]] * k + [self.pos[w.root]])  # robots, then the base
+        progress = [0.0] * k  # share of the edge behind the robot
+        xy = np.array([self.pos[w.root]] * (k + 1))  # robots, then the base
         arrived_by: list[float | None] = [None] * k
         wake = [0] * k  # tick at which a robot at a vertex decides
         paths = [[w.root] for _ in range(k)]
-        ids = list(range(k)) + [BASE]
-        radio = Radio(ids, range_m=self.range_m)
+        radio = Radio(list(range(k)) + [BASE], range_m=self.range_m)
         radio.move(xy)
-        tethers = [Tether(i, self.range_m, ticks_per_unit=TICKS_PER_UNIT) for i in range(k)]
-        base = BaseStation()
         declared = infeasible = None
         cut = ticks = 0
         order = range(k - 1, -1, -1)
         last_tick = math.floor(max_time * TICKS_PER_UNIT)
         while declared is None and infeasible is None and ticks < last_tick:
             tick = ticks = ticks + 1
-            now = tick / TICKS_PER_UNIT
             radio.step(xy)
-            around = [self._around(radio, i, xy) for i in range(k)]
             if constrained:
+                around = [self._around(radio, i, xy) for i in range(k)]
                 for i in order:
-                    for m in tethers[i].hear(tick, radio.receive(i), around[i]):
+                    for m in robots[i].hear(tick, radio.receive(i), around[i]):
                         radio.send(i, m.payload, m.to)
                 for m in base.step(radio.receive(BASE)):
                     radio.send(BASE, m.payload, m.to)
             deciding = [i for i in order if at[i] is not None and wake[i] <= tick]
             for i in deciding:  # bookkeeping first, then decisions (graph world)
-                minds[i].arrive(beacons[at[i]], w.angles[at[i]], arrived_by[i])
+                robots[i].arrive(beacons[at[i]], w.angles[at[i]], arrived_by[i])
             for i in deciding:
                 v = at[i]
-                decision = minds[i].on_vertex(beacons[v], w.angles[v], arrived_by[i])
+                decision = robots[i].on_vertex(beacons[v], w.angles[v], arrived_by[i])
                 if beacons[v].id is not None and beacons[v].id not in beacon_vertex:
                     beacon_vertex[beacons[v].id] = v
                 if decision.action == "go":
@@ -138,36 +144,44 @@ class RadioGraphWorld:
                 elif decision.action == "idle":
                     arrived_by[i], wake[i] = None, tick + TICKS_PER_UNIT
                 elif decision.action == "done":
-                    declared = (now, i, v)
+                    declared = (tick / TICKS_PER_UNIT, i, v)
                     break
                 else:
                     raise ValueError(f"robot {i + 1} answered an unknown decision {decision!r}")
             if declared is not None:
                 break
-            steps = {i: self._step(edge[i], progress[i]) for i in order if edge[i] is not None}
-            moved = {i: not constrained or tethers[i].may_step(steps[i], around[i]) for i in steps}
-            for i, go in moved.items():
-                if not go:
+            wanted: dict[int, tuple[float, float]] = {}
+            moved = set()
+            for i in order:
+                if edge[i] is None:
+                    continue
+                sense = robots[i].direction(progress[i]) if constrained else 1
+                if sense == 0:
                     continue
                 v, u = edge[i]
-                progress[i] += 1.0 / (w.duration[(v, u)] * TICKS_PER_UNIT)
-                if progress[i] >= 1.0 - 1e-9:
+                share = min(1.0 / (w.duration[(v, u)] * TICKS_PER_UNIT),
+                            1.0 - progress[i] if sense > 0 else progress[i])
+                d = sense * share * (self.pos[u] - self.pos[v])
+                step = (float(d[0]), float(d[1]))
+                if constrained and not robots[i].tether.may_step(step, around[i]):
+                    wanted[i] = step
+                    continue
+                moved.add(i)
+                progress[i] += sense * share
+                if sense > 0 and progress[i] >= 1.0 - 1e-9:
                     at[i], edge[i], wake[i] = u, None, tick + 1
                     paths[i].append(u)
-                    xy[i] = self.pos[u]
-                else:
-                    xy[i] = self.pos[v] + progress[i] * (self.pos[u] - self.pos[v])
+                elif sense < 0 and progress[i] <= 1e-9:
+                    at[i], edge[i], wake[i], arrived_by[i] = v, None, tick + 1, w.angle_of[(v, u)]
+                    robots[i].arrived_back()
+                xy[i] = self.pos[v] + progress[i] * (self.pos[u] - self.pos[v])
             if constrained:
                 radio.move(xy)
-                after = [self._around(radio, i, xy) for i in range(k)]
                 for i in order:
-                    stuck = i in moved and not moved[i]
-                    want = steps[i] if stuck else None
-                    for m in tethers[i].ask(tick, want, after[i]):
+                    for m in robots[i].after(tick, wanted.get(i), i in moved,
+                                             self._around(radio, i, xy)):
                         radio.send(i, m.payload, m.to)
-                    m = tethers[i].beat(tick, moved.get(i, False))
-                    radio.send(i, m.payload, m.to)
-                if any(t.stalled(tick) for t in tethers):
+                if any(r.tether.stalled(tick) for r in robots):
                     infeasible = tick
             cut += not self._all_connected(xy)
         completed_at = None if declared is None else declared[0]
@@ -181,7 +195,8 @@ class RadioGraphWorld:
         return ConnectedExplorationResult(
             **fields, connectivity=self.connectivity, radio_range_m=self.range_m,
             messages=radio.total_sent, connected_share=1.0 - cut / max(ticks, 1),
-            cut_ticks=cut, infeasible=infeasible is not None, reason=reason)
+            cut_ticks=cut, relay_trips=sum(r.relay_trips for r in robots),
+            infeasible=infeasible is not None, reason=reason)
 
     def _follow(self, vertex: str, angle: float) -> str:
         """The neighbour along the edge at ``vertex`` nearest to ``angle``."""
