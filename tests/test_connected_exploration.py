@@ -32,13 +32,18 @@ CASES += [(f"random-tree:{e}:{s}", k, r) for s, e in enumerate((8, 12, 16))
           for k in (3, 5) for r in (0.9, 1.8)]
 
 
+@pytest.mark.parametrize("connectivity", ["connected", "biconnected"])
 @pytest.mark.parametrize("arena,robots,range_m", CASES)
-def test_no_robot_is_ever_cut_off_and_every_run_ends_by_a_verdict(arena, robots, range_m):
+def test_the_constraint_always_holds_and_every_run_ends_by_a_verdict(arena, robots, range_m,
+                                                                     connectivity):
     """Ground truth (networkx, every tick): with ``connected`` every robot always has a
-    route to the base; the run ends by completion with the true map or by a declared
-    stall, never at the time limit."""
-    result, world = run(arena, robots, range_m)
+    route to the base, with ``biconnected`` the radio graph with the base is biconnected;
+    the run ends by completion with the true map or by a declared stall, never at the
+    time limit."""
+    result, world = run(arena, robots, range_m, connectivity)
     assert result.cut_ticks == 0 and result.connected_share == 1.0
+    if connectivity == "biconnected":
+        assert result.fragile_ticks == 0 and result.biconnected_share == 1.0
     assert result.completed != result.infeasible
     if result.completed:
         assert result.map_correct
@@ -52,6 +57,11 @@ def test_the_check_has_teeth_unconstrained_robots_get_cut_off():
     assert len(cut) == 15 and all(c > 0 for c in cut)
 
 
+def test_the_check_has_teeth_a_connected_team_is_not_always_biconnected():
+    fragile = [run(a, k, r, "connected")[0].fragile_ticks for a, k, r in CASES if r == 1.3]
+    assert sum(f > 0 for f in fragile) >= 10
+
+
 @pytest.mark.parametrize("arena,robots", [("lattice:5x5", 4), ("arena2", 4), ("fig9", 2),
                                           ("random-graph:12:16:3", 5)])
 def test_a_range_beyond_the_arena_changes_nothing(arena, robots):
@@ -62,6 +72,8 @@ def test_a_range_beyond_the_arena_changes_nothing(arena, robots):
     assert tied.completed and tied.map_correct
     assert (tied.paths, tied.makespan) == (free.paths, free.makespan)
     assert tied.cut_ticks == free.cut_ticks == 0
+    both, _ = run(arena, robots, 100.0, "biconnected")  # the first robot is pinned: it
+    assert both.completed and both.map_correct and both.fragile_ticks == 0  # relays
 
 
 def test_too_few_robots_for_the_range_is_reported_infeasible_before_the_time_limit():
@@ -85,7 +97,7 @@ def test_relays_carry_the_team_down_a_path_longer_than_the_range(robots, complet
 # ---------------------------------------------------------------------------- the tether
 def test_the_leash_keeps_the_parent_in_range():
     t = Tether(0, range_m=1.0)
-    t.hear(1, [Message(Beat(None, 0, True, 0, 0), sender=BASE)], {BASE: (-0.9, 0.0)})
+    t.hear(1, [Message(Beat((), 0, True, 0, 0), sender=BASE)], {BASE: (-0.9, 0.0)})
     assert t.may_step((0.05, 0.0), {BASE: (-0.9, 0.0)})
     assert not t.may_step((0.15, 0.0), {BASE: (-0.9, 0.0)})
 
@@ -96,15 +108,23 @@ def test_a_robot_with_children_holds():
     assert out == [Message(Adopted(1), to=2)]
     assert t.holding and not t.may_step((0.0, 0.0), {BASE: (0.1, 0.0)})
     # the child's beats name another parent and the grace is over: released
-    t.hear(5 + 5, [Message(Beat(BASE, 1, True, 9, 0), sender=2)], {2: (0.5, 0.0)})
+    t.hear(5 + 5, [Message(Beat((BASE,), 1, True, 9, 0), sender=2)], {2: (0.5, 0.0)})
     assert not t.holding
+
+
+def test_a_biconnected_robot_needs_both_parents_within_the_leash():
+    t = Tether(2, range_m=1.0, parents=(BASE, 0))
+    t.hear(1, [Message(Beat((), 0, True, 0, 0), sender=BASE),
+               Message(Beat((BASE,), 1, True, 0, 0), sender=0)], {BASE: (-0.5, 0.0), 0: (0.0, 0.9)})
+    assert t.may_step((0.1, 0.0), {BASE: (-0.5, 0.0), 0: (0.0, 0.9)})
+    assert not t.may_step((0.0, -0.2), {BASE: (-0.5, 0.0), 0: (0.0, 0.9)})  # robot 0 too far
 
 
 def test_crossing_requests_adopt_nobody():
     """Two robots asking each other at once both refuse: no cycle can close."""
     a, b = Tether(1, range_m=1.0), Tether(2, range_m=1.0)
     for t, other in ((a, 2), (b, 1)):
-        t.hear(1, [Message(Beat(BASE, 1, True, 0, 0), sender=other)], {other: (0.3, 0.0)})
+        t.hear(1, [Message(Beat((BASE,), 1, True, 0, 0), sender=other)], {other: (0.3, 0.0)})
         assert t.ask(1, (0.2, 0.0), {other: (0.3, 0.0)}) == [Message(Adopt(), to=other)]
     assert a.hear(2, [Message(Adopt(), to=1, sender=2)], {2: (0.3, 0.0)}) == []
     assert b.hear(2, [Message(Adopt(), to=2, sender=1)], {1: (0.3, 0.0)}) == []
@@ -117,7 +137,7 @@ def test_stall_after_the_stated_time():
     t.beat(3, moved=True, progressed=True, known_edges=2)
     patience = round((STALL_TIME_UNITS + 2 * STALL_UNITS_PER_EDGE) * TICKS_PER_UNIT)
     assert not t.stalled(3 + patience - 1) and t.stalled(3 + patience)
-    t.hear(3 + patience, [Message(Beat(BASE, 1, False, 3 + patience, 5), sender=1)], {})
+    t.hear(3 + patience, [Message(Beat((BASE,), 1, False, 3 + patience, 5), sender=1)], {})
     assert not t.stalled(3 + patience)  # news of progress elsewhere
 
 
@@ -147,5 +167,5 @@ def test_cli_bad_input_is_one_line(capsys, argv, message):
 
 def test_bad_connectivity_is_one_clear_error():
     spec = load_arena("fig9")
-    with pytest.raises(MjswarmError, match="connectivity must be one of none, connected"):
-        RadioGraphWorld(GraphWorld(spec.graph(), spec.root), 1.0, "biconnected")
+    with pytest.raises(MjswarmError, match="connectivity must be one of none, connected, biconnected"):
+        RadioGraphWorld(GraphWorld(spec.graph(), spec.root), 1.0, "triconnected")

@@ -7,12 +7,17 @@ the tether only gates and delays moves. Every rule below is ours (the seeds give
 this combination):
 
 1. **Tether.** Every robot has a *parent*: the base or a robot within radio range. The
-   parent relation is a tree rooted at the base.
+   parent relation is a tree rooted at the base. For ``biconnected`` every robot but the
+   first has two distinct parents and the first keeps the base as its one parent, for
+   good; the parent relation is then acyclic, so ordered from the base every robot joins
+   the ones before it by two links, and a graph grown from an edge (base and first robot)
+   by vertices joined to two earlier ones is biconnected: one robot failing never cuts
+   anyone off (seed 004's two access paths). Rules 2-4 hold for every parent.
 2. **Holding** (seed 001's repeater role). A robot with children does not move: it relays.
    Its children are the robots whose last beat named it as parent, and those it adopted
    in the last ``ADOPT_GRACE_TICKS`` ticks (their first beat naming it is on its way).
-3. **Leash.** A robot without children takes a step only if, after the step, its parent
-   is within range ``R - margin`` of it. It knows where its radio neighbours are relative
+3. **Leash.** A robot without children takes a step only if, after the step, its parents
+   are within range ``R - margin`` of it. It knows where its radio neighbours are relative
    to itself (a range-and-bearing sensor, as seed 001's robots have) and what its own
    step will be. Parents hold and the base never moves, so every tree link survives every
    tick, and nobody is ever cut off from the base.
@@ -61,11 +66,11 @@ BASE = "base"
 
 
 class Beat(NamedTuple):
-    """Sent by every robot every tick: its parent, its hops from the base, whether it
+    """Sent by every robot every tick: its parents, its hops from the base, whether it
     stood still in its last tick, the last tick at which it knows an exploring robot
     reached a vertex, and the most edges it knows a robot's map to hold (rule 5)."""
 
-    parent: Hashable | None
+    parents: tuple
     depth: int
     still: bool
     last_progress: int
@@ -88,20 +93,25 @@ class Tether:
     Args:
         me: this robot's radio id.
         range_m: the radio range R (m).
-        margin_m: the leash keeps the parent within ``R - margin_m``.
+        parents: its parents at the start (one for ``connected``; two for
+            ``biconnected``, see :func:`initial_parents`); it keeps as many.
+        pinned: it never changes parents (the first robot of a biconnected team).
+        margin_m: the leash keeps the parents within ``R - margin_m``.
         ticks_per_unit: control ticks per time unit (for the stall rule).
     """
 
-    def __init__(self, me: Hashable, range_m: float, margin_m: float = 0.0,
-                 ticks_per_unit: int = 10) -> None:
+    def __init__(self, me: Hashable, range_m: float, parents: tuple = (BASE,),
+                 pinned: bool = False, margin_m: float = 0.0, ticks_per_unit: int = 10) -> None:
         self.me = me
         self.leash_m = range_m - margin_m
         self.ticks_per_unit = ticks_per_unit
-        self.parent: Hashable = BASE
+        self.parents: tuple = tuple(parents)
+        self.pinned = pinned
         self.depth = 1
         self.adopted: dict[Hashable, int] = {}  # child -> tick of adoption
         self.children: set[Hashable] = set()
-        self.request: tuple[Hashable, int] | None = None  # (asked robot, tick asked)
+        #: (asked robot, tick asked, the parent it would replace)
+        self.request: tuple[Hashable, int, Hashable] | None = None
         self.heard: dict[Hashable, Beat] = {}
         self.last_progress = 0  # tick
         self.known_edges = 0
@@ -130,16 +140,18 @@ class Tether:
             elif isinstance(p, Adopted) and self.request is not None and m.sender == self.request[0]:
                 answer = (m.sender, p.depth)
         if answer is not None:
+            replaced = self.request[2]
             self.request = None
-            if self._within((0.0, 0.0), around.get(answer[0])):  # the parent holds from now
-                self.parent, self.depth = answer[0], answer[1] + 1
+            if answer[0] not in self.parents and self._within((0.0, 0.0), around.get(answer[0])):
+                self.parents = tuple(answer[0] if q == replaced else q for q in self.parents)
         elif self.request is not None and tick - self.request[1] > 2:
             self.request = None  # no answer: the request or its answer did not arrive
-        if self.parent in self.heard:
-            self.depth = self.heard[self.parent].depth + 1
+        depths = [self.heard[q].depth for q in self.parents if q in self.heard]
+        if len(depths) == len(self.parents):
+            self.depth = max(depths) + 1
         self.adopted = {c: t for c, t in self.adopted.items() if tick - t <= ADOPT_GRACE_TICKS}
         self.children = set(self.adopted) | {c for c, b in self.heard.items()
-                                             if b.parent == self.me}
+                                             if self.me in b.parents}
         return out
 
     def may_step(self, step: Sequence[float], around: Mapping[Hashable, Sequence[float]]) -> bool:
@@ -147,36 +159,38 @@ class Tether:
         radio neighbours are relative to it (m)."""
         if self.children or self.request is not None:
             return False
-        return self._within(step, around.get(self.parent))
+        return all(self._within(step, around.get(q)) for q in self.parents)
 
     def ask(self, tick: int, step: Sequence[float] | None,
             around: Mapping[Hashable, Sequence[float]]) -> list[Message]:
         """Rule 4, asking side: after a tick in which this robot wanted to take ``step``
-        (None: it wanted to stay) and did not, or could do with a parent nearer the base."""
-        if self.request is not None:
+        (None: it wanted to stay) and did not, or could do with a parent nearer the base.
+        With two parents it replaces one at a time: the first that forbids the step, else
+        the one farthest from the base (in hops)."""
+        if self.request is not None or self.pinned:
             return []
+        deepest = max(self.parents, key=lambda q: self._depth_of(q))
         if self.children:  # a relay may hop straight to the base: it is nobody's descendant
-            if self.parent != BASE and BASE in self.heard and self._within((0.0, 0.0), around.get(BASE)):
-                self.request = (BASE, tick)
-                return [Message(Adopt(), to=BASE)]
+            if BASE not in self.parents and BASE in self.heard and self._within((0.0, 0.0), around.get(BASE)):
+                return self._request(BASE, tick, deepest)
             return []
-        parent_depth = self.heard[self.parent].depth if self.parent in self.heard else math.inf
+        blocking = [q for q in self.parents if step is not None and not self._within(step, around.get(q))]
         best = None
         for r, beat in self.heard.items():
-            if r == self.parent or not beat.still or r not in around:
+            if r in self.parents or not beat.still or r not in around:
                 continue
-            if step is not None and self._within(step, around[r]):
-                key = (beat.depth, math.hypot(*around[r]))
-            elif beat.depth < parent_depth and self._within((0.0, 0.0), around[r]):
-                key = (beat.depth, math.hypot(*around[r]))
+            if blocking and self._within(step, around[r]):
+                replaced = blocking[0]
+            elif beat.depth < self._depth_of(deepest) and self._within((0.0, 0.0), around[r]):
+                replaced = deepest
             else:
                 continue
+            key = (beat.depth, math.hypot(*around[r]))
             if best is None or key < best[0]:
-                best = (key, r)
+                best = (key, r, replaced)
         if best is None:
             return []
-        self.request = (best[1], tick)
-        return [Message(Adopt(), to=best[1])]
+        return self._request(best[1], tick, best[2])
 
     def beat(self, tick: int, moved: bool, progressed: bool, known_edges: int) -> Message:
         """Rule 5's gossip, and what the others need of rules 2 and 4: ``progressed``
@@ -185,7 +199,7 @@ class Tether:
         if progressed:
             self.last_progress = tick
         self.known_edges = max(self.known_edges, known_edges)
-        return Message(Beat(self.parent, self.depth, not moved, self.last_progress,
+        return Message(Beat(self.parents, self.depth, not moved, self.last_progress,
                             self.known_edges))
 
     def stalled(self, tick: int) -> bool:
@@ -194,12 +208,29 @@ class Tether:
         return tick - self.last_progress >= math.ceil(patience * self.ticks_per_unit)
 
     # -------------------------------------------------------------- internals
+    def _request(self, asked: Hashable, tick: int, replaced: Hashable) -> list[Message]:
+        self.request = (asked, tick, replaced)
+        return [Message(Adopt(), to=asked)]
+
+    def _depth_of(self, q: Hashable) -> float:
+        return 0 if q == BASE else self.heard[q].depth if q in self.heard else math.inf
+
     def _within(self, step: Sequence[float], offset: Sequence[float] | None) -> bool:
         """Whether a robot at ``offset`` (m, relative to here) is within the leash after
         ``step``."""
         if offset is None:
             return False
         return math.hypot(offset[0] - step[0], offset[1] - step[1]) <= self.leash_m
+
+
+def initial_parents(robot: int, need: int) -> tuple[tuple, bool]:
+    """Parents at the start, all robots standing on the root, and whether they are pinned:
+    with ``need`` 1, the base; with 2, the base and the first robot, which keeps the base
+    as its only parent for good (so the base and it form the biconnected core every
+    other robot hangs from by two distinct parents: rule 1 for ``biconnected``)."""
+    if need == 1:
+        return (BASE,), False
+    return ((BASE,), True) if robot == 0 else ((BASE, 0), False)
 
 
 class BaseStation:
@@ -222,5 +253,5 @@ class BaseStation:
                 out.append(Message(Adopted(0), to=m.sender))
             elif self.flooder.fresh(p):
                 out.append(Message(p))
-        out.append(Message(Beat(None, 0, True, self.last_progress, self.known_edges)))
+        out.append(Message(Beat((), 0, True, self.last_progress, self.known_edges)))
         return out

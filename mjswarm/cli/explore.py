@@ -138,9 +138,10 @@ def register(subparsers) -> None:
                              "strategies' fixed tie rules)")
     parser.add_argument("--connectivity", default=None, choices=CONNECTIVITY,
                         help="none: explore as seed 003 (default); connected: every robot "
-                             "keeps a radio route to the base at the root (needs "
-                             "--radio-range; graph world only so far); a team that cannot "
-                             "go on says so (infeasible) and stops")
+                             "keeps a radio route to the base at the root; biconnected: two "
+                             "disjoint routes, so that one robot failing cuts nobody off. "
+                             "Needs --radio-range; graph world only so far. A team that "
+                             "cannot go on says so (infeasible) and stops")
     parser.add_argument("--radio-range", type=float, default=None, metavar="M",
                         help="radio range, m. Graph world: robots and a base at the root "
                              "talk within it (walls ignored), and the result reports "
@@ -253,8 +254,10 @@ def summary(result: dict) -> str:
     radio = []
     if result.get("connectivity") is not None:
         radio = [f"radio {result['radio_range_m']:g} m, connectivity {result['connectivity']}: "
-                 f"{result['messages']} messages; every robot reached the base in "
-                 f"{100 * result['connected_share']:.1f} % of the ticks"]
+                 f"{result['messages']} messages, {result['relay_trips']} relay trips; every "
+                 f"robot reached the base in {100 * result['connected_share']:.1f} % of the "
+                 f"ticks, the team with the base was biconnected in "
+                 f"{100 * result['biconnected_share']:.1f} %"]
     if not result["completed"]:
         why = result.get("reason") or result.get("ended_because", "max time")
         lines = [head, f"not completed ({why}): no robot declared completion", *radio]

@@ -10,7 +10,7 @@ at the root. Radio links join robots, and the base, within ``radio_range_m`` of 
 ``connectivity``:
 
 * ``"none"``: seed 003 unchanged (robots never wait; no messages).
-* ``"connected"``: each robot keeps its tether (:mod:`algorithms.exploration.tether`) and
+* ``"connected"`` / ``"biconnected"``: each robot keeps its tether of one / two parents (:mod:`algorithms.exploration.tether`) and
   stuck robots are brought relays (:mod:`algorithms.exploration.relay`); robots walk
   edges both ways and may stop part-way.
 
@@ -24,7 +24,8 @@ One tick, for every robot in descending index (the order of seed 003's Fig. 9 ru
 4. robots that wanted to move and could not, or could use a parent nearer the base, ask
    for adoption; every robot beats;
 5. ground truth (loop functions only): the radio graph of the base and the robots, with
-   networkx, counts the ticks in which some robot has no route to the base.
+   networkx, counts the ticks in which some robot has no route to the base, and those in
+   which the graph is not biconnected (one robot failing would cut someone off).
 
 The run ends when a robot declares completion, when a robot declares a stall (rule 5 of
 the tether: the result is ``infeasible``, with the explored share of the true edges), or
@@ -42,12 +43,14 @@ import numpy as np
 from algorithms.exploration import Beacon, Strategy
 from algorithms.exploration.base import angle_gap
 from algorithms.exploration.relay import ConnectedExplorer, Flooder
-from algorithms.exploration.tether import BASE, BaseStation, Tether
+from algorithms.exploration.tether import BASE, BaseStation, Tether, initial_parents
 from mjswarm.core.radio import Radio
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.graphworld import ExplorationResult, GraphWorld, outcome
 
-CONNECTIVITY = ("none", "connected")
+CONNECTIVITY = ("none", "connected", "biconnected")
+#: Parents each robot keeps under each constraint (rule 1 of the tether).
+NEED = {"connected": 1, "biconnected": 2}
 #: Control ticks per time unit (one edge in the unit-time graph world).
 TICKS_PER_UNIT = 10
 
@@ -63,6 +66,9 @@ class ConnectedExplorationResult(ExplorationResult):
         connected_share: share of ticks in which every robot had a route to the base
             (ground truth).
         cut_ticks: ticks in which some robot had none.
+        biconnected_share: share of ticks in which the radio graph of the base and the
+            robots was biconnected (ground truth).
+        fragile_ticks: ticks in which it was not.
         relay_trips: relay missions the robots set out on (rule 6 of
             :mod:`algorithms.exploration.relay`).
         infeasible: whether the team declared that it cannot go on.
@@ -74,6 +80,8 @@ class ConnectedExplorationResult(ExplorationResult):
     messages: int = 0
     connected_share: float = 1.0
     cut_ticks: int = 0
+    biconnected_share: float = 1.0
+    fragile_ticks: int = 0
     relay_trips: int = 0
     infeasible: bool = False
     reason: str | None = None
@@ -100,8 +108,9 @@ class RadioGraphWorld:
         w, k = self.world, len(minds)
         if max_time is None:
             max_time = 50 * (len(w.edges) + 1) + 100
-        constrained = self.connectivity == "connected"
-        robots = [ConnectedExplorer(i, minds[i], Tether(i, self.range_m,
+        constrained = self.connectivity != "none"
+        need = NEED.get(self.connectivity, 1)
+        robots = [ConnectedExplorer(i, minds[i], Tether(i, self.range_m, *initial_parents(i, need),
                                                         ticks_per_unit=TICKS_PER_UNIT))
                   for i in range(k)]
         base = BaseStation(Flooder())
@@ -117,7 +126,7 @@ class RadioGraphWorld:
         radio = Radio(list(range(k)) + [BASE], range_m=self.range_m)
         radio.move(xy)
         declared = infeasible = None
-        cut = ticks = 0
+        cut = fragile = ticks = 0
         order = range(k - 1, -1, -1)
         last_tick = math.floor(max_time * TICKS_PER_UNIT)
         while declared is None and infeasible is None and ticks < last_tick:
@@ -183,7 +192,9 @@ class RadioGraphWorld:
                         radio.send(i, m.payload, m.to)
                 if any(r.tether.stalled(tick) for r in robots):
                     infeasible = tick
-            cut += not self._all_connected(xy)
+            graph = self._radio_graph(xy)
+            cut += not nx.is_connected(graph)
+            fragile += not nx.is_biconnected(graph)
         completed_at = None if declared is None else declared[0]
         fields = outcome(minds, declared, completed_at, paths, beacon_vertex, w.edges,
                          arena=arena, root=w.root, edge_time=w.edge_time, seed=seed)
@@ -195,7 +206,8 @@ class RadioGraphWorld:
         return ConnectedExplorationResult(
             **fields, connectivity=self.connectivity, radio_range_m=self.range_m,
             messages=radio.total_sent, connected_share=1.0 - cut / max(ticks, 1),
-            cut_ticks=cut, relay_trips=sum(r.relay_trips for r in robots),
+            cut_ticks=cut, biconnected_share=1.0 - fragile / max(ticks, 1),
+            fragile_ticks=fragile, relay_trips=sum(r.relay_trips for r in robots),
             infeasible=infeasible is not None, reason=reason)
 
     def _follow(self, vertex: str, angle: float) -> str:
@@ -215,11 +227,11 @@ class RadioGraphWorld:
         here = xy[i]
         return {r: tuple(xy[len(xy) - 1 if r == BASE else r] - here) for r in radio.neighbors(i)}
 
-    def _all_connected(self, xy: np.ndarray) -> bool:
-        """Ground truth: every robot has a radio route to the base (networkx)."""
+    def _radio_graph(self, xy: np.ndarray) -> nx.Graph:
+        """Ground truth: the radio graph of the robots and the base (the last node)."""
         g = nx.Graph()
         n = len(xy)
         g.add_nodes_from(range(n))
         d2 = ((xy[:, None] - xy[None]) ** 2).sum(axis=-1)
         g.add_edges_from(zip(*np.nonzero(np.triu(d2 <= self.range_m**2, 1))))
-        return nx.is_connected(g)
+        return g
