@@ -10,7 +10,7 @@ from mjswarm.arena import load_arena
 from mjswarm.cli import main
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.graphworld import GraphWorld
-from mjswarm.outputs.sweep import Cell, ResultsFile, grid, run_cell, sweep
+from mjswarm.outputs.sweep import CELL_KEYS, Cell, ResultsFile, grid, run_cell, sweep
 
 ARGS = ["sweep", "--arenas", "fig9,tree1", "--robots", "2-3", "--strategies",
         "incidence-dfs,mr-dfs", "--seeds", "0,1"]
@@ -53,8 +53,7 @@ def test_ray_backend_on_a_local_two_cpu_instance(tmp_path):
     assert sweep(cells, out, backend="ray", workers=2) == (4, 0)
     local = {c.key: run_cell(c)["makespan"] for c in cells}
     for r in ResultsFile(out).read():
-        assert r["makespan"] == local[(r["world"], r["arena"], r["robots"], r["strategy"],
-                                       r["seed"])]
+        assert r["makespan"] == local[tuple(r[k] for k in CELL_KEYS)]
 
 
 def test_embodied_cell_runs():
@@ -87,3 +86,26 @@ def test_bad_sweeps_are_one_line(tmp_path, capsys, argv, message):
 def test_grid_rejects_nothing_to_do():
     with pytest.raises(MjswarmError, match="at least one"):
         grid("graph", ["fig9"], [2], ["incidence-dfs"], [])
+
+
+def test_a_sweep_over_radio_ranges_and_constraints(tmp_path):
+    """Issue 17's grid: ranges x constraints in the graph world, each cell its own run."""
+    out = tmp_path / "radio.csv"
+    cells = grid("graph", ["arena2"], [4], ["incidence-dfs"], [0], [1.0, 50.0],
+                 ["none", "connected", "biconnected"])
+    assert sweep(cells, out, workers=1) == (6, 0)
+    rows = ResultsFile(out).read()
+    assert {(float(r["radio_range_m"]), r["connectivity"]) for r in rows} == {
+        (r, c) for r in (1.0, 50.0) for c in ("none", "connected", "biconnected")}
+    assert all(r["cut_ticks"] == "0" for r in rows if r["connectivity"] != "none")
+    assert sweep(cells, out, workers=1) == (0, 6)  # CSV keys read back: nothing to redo
+
+
+@pytest.mark.parametrize("kwargs,message", [
+    ({"ranges": [1.0], "connectivities": ["triconnected"]}, "unknown connectivity"),
+    ({"ranges": [None], "connectivities": ["connected"]}, "needs radio ranges"),
+    ({"ranges": [-1.0]}, "must be positive"),
+])
+def test_bad_radio_grids_are_refused(kwargs, message):
+    with pytest.raises(MjswarmError, match=message):
+        grid("graph", ["arena2"], [2], ["incidence-dfs"], [0], **kwargs)

@@ -34,6 +34,16 @@ def _ints(text: str, what: str) -> list[int]:
     return values
 
 
+def _floats(text: str | None, what: str) -> list[float | None]:
+    """``0.7,1,1.5`` (metres); no option: ``[None]`` (no radio)."""
+    if text is None:
+        return [None]
+    try:
+        return [float(part) for part in text.split(",") if part.strip()]
+    except ValueError:
+        raise MjswarmError(f"{what} takes numbers like 0.7,1,1.5, got '{text}'") from None
+
+
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "sweep",
@@ -49,6 +59,12 @@ def register(subparsers) -> None:
     parser.add_argument("--strategies", default="incidence-dfs", metavar="S,...",
                         help="strategies, comma-separated (default: incidence-dfs)")
     parser.add_argument("--seeds", default="0", metavar="N,...", help="seeds, e.g. 0-29")
+    parser.add_argument("--radio-ranges", default=None, metavar="M,...",
+                        help="graph world: radio ranges to sweep, m, e.g. 0.7,1,1.5 (default: "
+                             "no radio)")
+    parser.add_argument("--connectivity", default="none", metavar="C,...",
+                        help="graph world: constraints to sweep, of none, connected, "
+                             "biconnected (default: none; others need --radio-ranges)")
     parser.add_argument("--out", required=True, metavar="OUT", help="results file .jsonl or .csv")
     parser.add_argument("--backend", default="local",
                         help="local (process pool, default) or ray (pip install -e '.[ray]'; "
@@ -63,7 +79,8 @@ def run(args) -> int:
 
     cells = grid(args.world, [a for a in args.arenas.split(",") if a],
                  _ints(args.robots, "--robots"), [s for s in args.strategies.split(",") if s],
-                 _ints(args.seeds, "--seeds"))
+                 _ints(args.seeds, "--seeds"), _floats(args.radio_ranges, "--radio-ranges"),
+                 [c for c in args.connectivity.split(",") if c])
     done = ResultsFile(args.out).done()
     bar = tqdm(total=len(cells), initial=sum(c.key in done for c in cells), unit="run",
                desc="sweep", disable=None, file=sys.stderr)

@@ -1,7 +1,8 @@
 """Parameter sweeps: a grid of exploration runs, in parallel, resumable (issue 8 part 3).
 
-A sweep is the product arenas x robot counts x strategies x seeds in one world (``graph``
-or ``embodied``). Each cell is one run of :func:`run_cell`; results are appended to one
+A sweep is the product arenas x robot counts x strategies x seeds x radio ranges x
+connectivity constraints in one world (``graph`` or ``embodied``; ranges and constraints in
+the graph world only, :mod:`mjswarm.worlds.radiograph`). Each cell is one run of :func:`run_cell`; results are appended to one
 file as they finish, one record per cell (JSON lines, or CSV with list-valued fields as
 JSON text), so a sweep that is stopped and started again skips the cells already in the
 file. Backends: a local process pool (default) or a Ray cluster (``backend="ray"``; the
@@ -24,7 +25,9 @@ from mjswarm.errors import MjswarmError
 
 WORLDS = ("graph", "embodied")
 BACKENDS = ("local", "ray")
-CELL_KEYS = ("world", "arena", "robots", "strategy", "seed")
+CELL_KEYS = ("world", "arena", "robots", "strategy", "seed", "radio_range_m", "connectivity")
+#: What a results file written before radio ranges and constraints existed holds.
+CELL_DEFAULTS = {"radio_range_m": None, "connectivity": "none"}
 #: Largest team a sweep runs (the benchmark's largest; beyond it a run takes hours).
 MAX_ROBOTS = 1000
 
@@ -38,6 +41,8 @@ class Cell:
     robots: int
     strategy: str
     seed: int
+    radio_range_m: float | None = None
+    connectivity: str = "none"
 
     @property
     def key(self) -> tuple:
@@ -45,11 +50,25 @@ class Cell:
 
 
 def grid(world: str, arenas: Iterable[str], robots: Iterable[int], strategies: Iterable[str],
-         seeds: Iterable[int]) -> list[Cell]:
-    """Every combination, validated up front (unknown world / arena / strategy, K < 1)."""
+         seeds: Iterable[int], ranges: Iterable[float | None] = (None,),
+         connectivities: Iterable[str] = ("none",)) -> list[Cell]:
+    """Every combination, validated up front (unknown world / arena / strategy /
+    constraint, K < 1, a range that is not positive, a constraint without a range)."""
     from algorithms.exploration import STRATEGIES
     from mjswarm.arena import load_arena
+    from mjswarm.worlds.radiograph import CONNECTIVITY
 
+    ranges, connectivities = list(ranges), list(connectivities)
+    for c in connectivities:
+        if c not in CONNECTIVITY:
+            raise MjswarmError(f"unknown connectivity '{c}' (choose from {', '.join(CONNECTIVITY)})")
+    if any(r is not None and not r > 0 for r in ranges):
+        raise MjswarmError("radio ranges must be positive (m)")
+    if world != "graph" and (ranges != [None] or connectivities != ["none"]):
+        raise MjswarmError("radio ranges and connectivity constraints sweep in the graph "
+                           "world only (--world graph)")
+    if None in ranges and any(c != "none" for c in connectivities):
+        raise MjswarmError("a connectivity constraint needs radio ranges (--radio-ranges)")
     if world not in WORLDS:
         raise MjswarmError(f"unknown world '{world}' (choose from {', '.join(WORLDS)})")
     arenas, robots, strategies, seeds = list(arenas), list(robots), list(strategies), list(seeds)
@@ -65,8 +84,8 @@ def grid(world: str, arenas: Iterable[str], robots: Iterable[int], strategies: I
                            "mjswarm bench measures up to 1000 robots)")
     if not (arenas and strategies and seeds):
         raise MjswarmError("a sweep needs at least one arena, strategy and seed")
-    return [Cell(world, a, k, s, seed)
-            for a, k, s, seed in itertools.product(arenas, robots, strategies, seeds)]
+    return [Cell(world, a, k, s, seed, r, c) for a, k, s, seed, r, c in
+            itertools.product(arenas, robots, strategies, seeds, ranges, connectivities)]
 
 
 def run_cell(cell: Cell) -> dict:
@@ -75,10 +94,16 @@ def run_cell(cell: Cell) -> dict:
 
     spec = load_arena(cell.arena)
     if cell.world == "graph":
-        from mjswarm.worlds.graphworld import GraphWorld
+        from mjswarm.worlds.graphworld import GraphWorld, make_minds
+        from mjswarm.worlds.radiograph import RadioGraphWorld
 
-        result = GraphWorld(spec.graph(), spec.root).explore(
-            cell.robots, cell.strategy, seed=cell.seed, arena=spec.name)
+        world = GraphWorld(spec.graph(), spec.root)
+        if cell.radio_range_m is None:
+            result = world.explore(cell.robots, cell.strategy, seed=cell.seed, arena=spec.name)
+        else:
+            result = RadioGraphWorld(world, cell.radio_range_m, cell.connectivity).run(
+                make_minds(cell.strategy, cell.robots, cell.seed), seed=cell.seed,
+                arena=spec.name)
     else:
         from mjswarm.experiments.exploration import explore_embodied
 
@@ -103,7 +128,8 @@ class ResultsFile:
         """Keys of the cells already in the file."""
         if not self.path.exists():
             return set()
-        return {tuple(_coerce(r[k]) for k in CELL_KEYS) for r in self.read()}
+        return {tuple(_coerce(r.get(k, CELL_DEFAULTS.get(k))) for k in CELL_KEYS)
+                for r in self.read()}
 
     def read(self) -> list[dict]:
         if not self.path.exists():
@@ -131,8 +157,17 @@ class ResultsFile:
 
 
 def _coerce(value):
-    """CSV cells come back as text: numbers to int where they are."""
-    return int(value) if isinstance(value, str) and value.lstrip("-").isdigit() else value
+    """CSV cells come back as text: numbers to int or float where they are, empty to None."""
+    if not isinstance(value, str):
+        return value
+    if value == "":
+        return None
+    if value.lstrip("-").isdigit():
+        return int(value)
+    try:
+        return float(value)
+    except ValueError:
+        return value
 
 
 def sweep(cells: list[Cell], out: str | Path, backend: str = "local", workers: int | None = None,
