@@ -169,3 +169,16 @@ def test_bad_connectivity_is_one_clear_error():
     spec = load_arena("fig9")
     with pytest.raises(MjswarmError, match="connectivity must be one of none, connected, biconnected"):
         RadioGraphWorld(GraphWorld(spec.graph(), spec.root), 1.0, "triconnected")
+
+
+def test_the_readme_table_script_runs():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "connected_exploration_table.py"
+    spec = importlib.util.spec_from_file_location("table", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    lines = module.rows(["fig9"], [2], [1.0, 50.0])
+    assert len(lines) == 4 and lines[2].startswith("| fig9 | 2 | 1 |")
+    assert lines[3].count("/ 0 |") >= 2  # at 50 m nobody needs a relay
