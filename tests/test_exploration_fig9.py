@@ -75,8 +75,8 @@ def test_fig9_final_matrix_is_v_by_e(run):
 def test_fig9_matrix_at_v6_after_10th_update_matches_paper(run):
     """I10(v6): R1 at v6 at step 5 is the 10th update (R2's update of each step first).
 
-    Orderings: our rows are in order of first knowledge and our columns keep the merge
-    order inside each block (completed | out | unexplored, Algorithm 2), where the paper
+    Orderings: our rows, and our completed and unexplored columns (blocks completed | out |
+    unexplored, Algorithm 2), are in the order the team first wrote them, where the paper
     lists rows newest first; only the entries are compared. The printed +2*pi for e68 at
     v6 is a misprint: R2 left v6 along e68 at step 3, which eq. (5) makes out (-2*pi).
     """

@@ -178,6 +178,44 @@ def test_status_and_select():
     assert done.out == {} and done.select(("a1", math.pi), "c") is done
 
 
+def test_selectors_angles_and_numberings():
+    e = ("a1", math.pi)
+    m = IncidenceMatrix.initial("a1", (math.pi, TWO_PI)).select(e, "a").select(e, "b")
+    assert m.selectors(e) == {"a", "b"} and m.selectors(("a1", TWO_PI)) == frozenset()
+    assert m.angles("a1") == (math.pi, TWO_PI)
+    with pytest.raises(KeyError):
+        m.angles("b1")
+    # matrices written in one numbering merge as they are; others are renumbered first
+    column = IncidenceMatrix.edge(e, (math.pi, TWO_PI), ("b1", 1.0), (1.0,), m.numbering)
+    alone = IncidenceMatrix.edge(e, (math.pi, TWO_PI), ("b1", 1.0), (1.0,))
+    assert merge(m, column).numbering is m.numbering is column.numbering
+    assert alone.numbering is not m.numbering
+    assert merge(m, alone).completed == merge(m, column).completed == {e: ("b1", 1.0),
+                                                                       ("b1", 1.0): e}
+    assert merge(m, column).out == {} and merge(m, column).selectors(e) == frozenset()
+    with pytest.raises(ValueError):  # a tag names one vertex, with one row
+        IncidenceMatrix.initial("a1", (1.0,), m.numbering)
+
+
+def test_an_end_completed_towards_two_ends():
+    """A beacon wiped and dropped again gives its vertex a second tag, so an edge end can
+    be completed towards both names. A merge keeps the other end known to the operand with
+    fewer completed ends, and takes a one-edge matrix as known when the other operand knows
+    its rows and its first end as completed (as the dictionary union did; the wiped-beacon
+    fault run depends on it)."""
+    x, old, new, y = ("x1", 1.0), ("a1", 2.0), ("a2", 2.0), ("y1", 3.0)
+    a1 = (2.0, 4.0)
+    a = IncidenceMatrix.edge(x, (1.0,), old, a1)
+    a = merge(a, IncidenceMatrix.edge(("a1", 4.0), a1, y, (3.0,), a.numbering))
+    b = IncidenceMatrix.edge(x, (1.0,), new, (2.0,), a.numbering)
+    m = merge(a, b)
+    assert m.completed[x] == new and m.completed[old] == x and merge(b, a).completed == m.completed
+    assert m.distances("x1") == {"x1": 0, "a2": 1}
+    assert m.distances("a1") == {"a1": 0, "x1": 1, "y1": 1, "a2": 2}
+    known = merge(a, IncidenceMatrix.initial("a2", (2.0,), a.numbering))
+    assert merge(known, b) is known and known.completed[x] == old
+
+
 def test_beacon_ids_follow_the_paper_and_continue_past_26_robots():
     assert [beacon_id(0, 1), beacon_id(0, 2), beacon_id(1, 1)] == ["a1", "a2", "b1"]
     assert [robot_letters(i) for i in (0, 25, 26, 27, 51, 52, 701, 702)] == [

@@ -94,7 +94,7 @@ class FrontierExplorer(MapStrategy):
         if not self.queue:
             selected = self.select()
             self.matrix = self.matrix.select(selected, self.letters)
-            self._selectors = self.matrix.out[selected]
+            self._selectors = self.matrix.selectors(selected)
             self.queue = [*self.matrix.route(self.here, selected[0]), selected]
         end = self.queue.pop(0)
         return self.leave(record, end, self.queue[-1] if self.queue else end)
@@ -109,7 +109,7 @@ class FrontierExplorer(MapStrategy):
         status = before.status(selected)
         if status == COMPLETED:
             return False
-        return status != OUT or before.out[selected] <= self._selectors
+        return status != OUT or before.selectors(selected) <= self._selectors
 
     def observe(self) -> None:
         """Hook run after the first step, before any decision."""
@@ -123,14 +123,10 @@ class FrontierExplorer(MapStrategy):
         selected (out edges; see ``IncidenceMatrix.out``; a robot re-selecting must not be
         held back by its own earlier choice), then the smallest (beacon id, angle), or at
         random among those with an ``rng``."""
-        out, me = self.matrix.out, self.letters
-
-        def others(e: End) -> int:
-            who = out.get(e, ())
-            return len(who) - (me in who)
-
-        fewest = min(map(others, ends))
-        ties = sorted(e for e in ends if others(e) == fewest)
+        selectors, me = self.matrix.selectors, self.letters
+        others = [len(who) - (me in who) for who in map(selectors, ends)]
+        fewest = min(others)
+        ties = sorted(e for e, n in zip(ends, others) if n == fewest)
         return ties[0] if self.rng is None else ties[self.rng.integers(len(ties))]
 
 

@@ -19,20 +19,124 @@ union of ends with the status rule of Algorithm 1 (a negative entry wins over a 
 one; a completed column replaces a one-entry column). Matrices are never modified; robot
 and beacon share one object after a visit (Algorithm 4's ``In(vj) = In(Rk)``).
 :meth:`IncidenceMatrix.to_array` gives the dense matrix of the paper.
+
+Bit sets. The matrices merged during one exploration share a :class:`Numbering`, which
+gives every tag, every end and every (end, selecting robot) pair a bit position, in the
+order the team first wrote them. A matrix itself is a handful of integers used as bit sets
+(its known rows, their ends, the completed ends, the out ends, the selections), so
+Algorithm 1's union is a few ``|`` and the containment test a few ``&``, however large the
+matrix. A numbering is only a table of names, and only grows: what a matrix knows is what
+its bits say. ``rows``, ``completed`` and ``out`` are built from the bits when asked for,
+in numbering order (the order in which the team first wrote each entry). Matrices of
+different numberings (built directly, e.g. by a test) are merged after renumbering one.
 """
 
 from __future__ import annotations
 
-from collections import deque
+from collections.abc import Mapping
+from types import MappingProxyType
 
 import numpy as np
 
 End = tuple[str, float]
 
 _NOBODY: frozenset[str] = frozenset()
+#: ``IncidenceMatrix._moved`` when every completed end has its first-written other end.
+_UNMOVED: Mapping[int, End] = MappingProxyType({})
 
 #: Status of an end, ordered by how much is known (statuses only ever increase).
 UNKNOWN, UNEXPLORED, OUT, COMPLETED = -1, 0, 1, 2
+
+
+class Numbering:
+    """Bit positions of the tags, ends and selections written by the matrices of one
+    exploration (see the module docstring). Entries are added, never changed or removed.
+
+    A tag names one vertex with one row of angles (the row its beacon got when dropped);
+    writing a tag again with other angles raises ``ValueError``. The other end of a
+    completed end is recorded as first written; a matrix that learned another one (a
+    re-dropped beacon gives a vertex a second tag) keeps it in ``IncidenceMatrix._moved``.
+    """
+
+    __slots__ = ("choice_mask", "choices", "end_index", "ends", "other", "row_ends", "row_mask",
+                 "rows", "selections", "tag_bit", "tags")
+
+    def __init__(self) -> None:
+        #: tags by position, and each tag's bit
+        self.tags: list[str] = []
+        self.tag_bit: dict[str, int] = {}
+        #: tag -> incidence angles of its vertex (its ``I0`` row)
+        self.rows: dict[str, tuple[float, ...]] = {}
+        #: tag -> ``(angle, end position, end bit)`` of each edge at the vertex, by angle
+        self.row_ends: dict[str, tuple[tuple[float, int, int], ...]] = {}
+        #: tag -> the bits of all its ends
+        self.row_mask: dict[str, int] = {}
+        #: ends by position, and each end's position
+        self.ends: list[End] = []
+        self.end_index: dict[End, int] = {}
+        #: end position -> the other end of its completed edge, as first written
+        self.other: list[End | None] = []
+        #: end position -> {robot letters: bit of "that robot selected this end"}, and the
+        #: bits of all its selections
+        self.choices: list[dict[str, int]] = []
+        self.choice_mask: list[int] = []
+        #: number of selection bits given
+        self.selections = 0
+
+    def row(self, tag: str, angles: tuple[float, ...]) -> int:
+        """The bit of ``tag``, numbering it and the ends of its row if new."""
+        bit = self.tag_bit.get(tag)
+        if bit is not None:
+            if self.rows[tag] != angles:
+                raise ValueError(f"vertex {tag} written with two rows, "
+                                 f"{self.rows[tag]} and {angles}")
+            return bit
+        bit = self.tag_bit[tag] = 1 << len(self.tags)
+        self.tags.append(tag)
+        self.rows[tag] = angles
+        ends, mask = [], 0
+        for a in angles:
+            i = self.end((tag, a))
+            ends.append((a, i, 1 << i))
+            mask |= 1 << i
+        self.row_ends[tag] = tuple(ends)
+        self.row_mask[tag] = mask
+        return bit
+
+    def end(self, end: End) -> int:
+        """The position of ``end``, numbering it if new."""
+        i = self.end_index.get(end)
+        if i is None:
+            i = self.end_index[end] = len(self.ends)
+            self.ends.append(end)
+            self.other.append(None)
+            self.choices.append({})
+            self.choice_mask.append(0)
+        return i
+
+    def link(self, i: int, other: End) -> bool:
+        """Record ``other`` as the other end of end ``i`` unless one is recorded; whether
+        the recorded one is ``other``."""
+        first = self.other[i]
+        if first is None:
+            self.other[i] = other
+            return True
+        return first == other
+
+    def choice(self, i: int, robot: str) -> int:
+        """The bit of "robot ``robot`` selected end ``i``", numbering it if new."""
+        bits = self.choices[i]
+        bit = bits.get(robot)
+        if bit is None:
+            bit = bits[robot] = 1 << self.selections
+            self.selections += 1
+            self.choice_mask[i] |= bit
+        return bit
+
+
+def _positions(bits: int) -> list[int]:
+    """Positions of the set bits of ``bits``, lowest first."""
+    return [i for i, digit in enumerate(bin(bits)[:1:-1]) if digit == "1"]
 
 
 class IncidenceMatrix:
@@ -45,86 +149,173 @@ class IncidenceMatrix:
     column to the front of the out block, so the rightmost out column, the next one
     chosen, is the one selected least. Sets of selectors keep that round-robin through
     merges (a union), where a plain count would lose selections made concurrently.
+
+    ``numbering`` (see :class:`Numbering`) is the one to write the matrix's entries in;
+    None: a new one.
     """
 
-    __slots__ = ("_n_ends", "completed", "out", "rows")
+    # Bit sets (positions of ``numbering``): ``_tags`` the known rows, ``_ends`` the ends
+    # of those rows, ``_completed`` and ``_out`` the completed and out ends, ``_selections``
+    # who selected which out end (never a completed one). ``_moved``: end position -> other
+    # end, where it is not the one the numbering recorded first. ``_first``: the first key
+    # of ``completed`` as a dict would order it, the end of a one-edge matrix that a merge
+    # looks at (see :func:`merge`). ``_tree``: the source and the parents of the latest
+    # breadth-first search over ``Gc`` (see :meth:`layers`), reused by :meth:`route`.
+    __slots__ = ("_completed", "_ends", "_first", "_moved", "_out", "_selections", "_tags",
+                 "_tree", "numbering")
 
     def __init__(
         self,
         rows: dict[str, tuple[float, ...]],
         completed: dict[End, End],
         out: dict[End, frozenset[str]],
+        numbering: Numbering | None = None,
     ):
-        self.rows = rows
-        self.completed = completed
-        self.out = out
-        self._n_ends: int | None = None
+        n = _writable(numbering)
+        tags = ends = 0
+        for tag, angles in rows.items():
+            tags |= n.row(tag, tuple(angles))
+            ends |= n.row_mask[tag]
+        done, moved = 0, {}
+        for e, f in completed.items():
+            i = n.end(e)
+            done |= 1 << i
+            if not n.link(i, f):
+                moved[i] = f
+        marked = selections = 0
+        for e, who in out.items():
+            i = n.end(e)
+            if not done >> i & 1:
+                marked |= 1 << i
+                for robot in who:
+                    selections |= n.choice(i, robot)
+        self.numbering, self._tags, self._ends, self._completed = n, tags, ends, done
+        self._out, self._selections = marked, selections
+        self._moved, self._first = moved or _UNMOVED, next(iter(completed), None)
+        self._tree = None
 
     @classmethod
-    def initial(cls, tag: str, angles: tuple[float, ...]) -> IncidenceMatrix:
+    def _of(cls, numbering: Numbering, tags: int, ends: int, completed: int, out: int,
+            selections: int, moved: Mapping[int, End], first: End | None) -> IncidenceMatrix:
+        """A matrix from its bit sets (see the comment on ``__slots__``)."""
+        m = object.__new__(cls)
+        m.numbering, m._tags, m._ends, m._completed = numbering, tags, ends, completed
+        m._out, m._selections, m._moved, m._first = out, selections, moved, first
+        m._tree = None
+        return m
+
+    @classmethod
+    def initial(
+        cls, tag: str, angles: tuple[float, ...], numbering: Numbering | None = None
+    ) -> IncidenceMatrix:
         """``I0(vj)`` of eq. (14): one row, every edge of the vertex unexplored."""
-        return cls({tag: angles}, {}, {})
+        n = _writable(numbering)
+        return cls._of(n, n.row(tag, tuple(angles)), n.row_mask[tag], 0, 0, 0, _UNMOVED, None)
 
     @classmethod
     def edge(
-        cls, end_i: End, angles_i: tuple[float, ...], end_j: End, angles_j: tuple[float, ...]
+        cls, end_i: End, angles_i: tuple[float, ...], end_j: End, angles_j: tuple[float, ...],
+        numbering: Numbering | None = None,
     ) -> IncidenceMatrix:
         """``I'`` of Algorithm 3: the column of the completed edge ``e_ij`` (with the rows of
         its two vertices, whose other edges are unexplored unless known otherwise)."""
-        return cls(
-            {end_i[0]: angles_i, end_j[0]: angles_j}, {end_i: end_j, end_j: end_i}, {}
-        )
+        n = _writable(numbering)
+        tags = n.row(end_i[0], tuple(angles_i)) | n.row(end_j[0], tuple(angles_j))
+        i, j = n.end(end_i), n.end(end_j)
+        moved = {}
+        if not n.link(i, end_j):
+            moved[i] = end_j
+        if not n.link(j, end_i):
+            moved[j] = end_i
+        return cls._of(n, tags, n.row_mask[end_i[0]] | n.row_mask[end_j[0]],
+                       (1 << i) | (1 << j), 0, 0, moved or _UNMOVED, end_i)
+
+    # -- the matrix as dictionaries -----------------------------------------------------
+
+    @property
+    def rows(self) -> dict[str, tuple[float, ...]]:
+        """Tag -> incidence angles, for every known vertex (``Vc``)."""
+        n, known = self.numbering, self._tags
+        return {t: n.rows[t] for t in n.tags if known & n.tag_bit[t]}
+
+    @property
+    def completed(self) -> dict[End, End]:
+        """End -> other end, for both ends of every completed edge (``Ec``)."""
+        ends, other = self.numbering.ends, self._others()
+        return {ends[i]: other[i] for i in _positions(self._completed)}
+
+    @property
+    def out(self) -> dict[End, frozenset[str]]:
+        """Out end -> letters of the robots known to have selected it (``Eo``)."""
+        return {self.numbering.ends[i]: self._selectors(i) for i in _positions(self._out)}
 
     # -- queries --------------------------------------------------------------------
 
     def status(self, end: End) -> int:
         """``COMPLETED``, ``OUT``, ``UNEXPLORED`` or ``UNKNOWN`` (vertex not a row)."""
-        if end in self.completed:
-            return COMPLETED
-        if end in self.out:
-            return OUT
-        return UNEXPLORED if end[0] in self.rows else UNKNOWN
+        n = self.numbering
+        i = n.end_index.get(end)
+        if i is not None:
+            if self._completed >> i & 1:
+                return COMPLETED
+            if self._out >> i & 1:
+                return OUT
+        return UNEXPLORED if self._tags & n.tag_bit.get(end[0], 0) else UNKNOWN
+
+    def angles(self, tag: str) -> tuple[float, ...]:
+        """The row of a known vertex: its incidence angles (``KeyError`` if unknown)."""
+        if not self._tags & self.numbering.tag_bit.get(tag, 0):
+            raise KeyError(tag)
+        return self.numbering.rows[tag]
+
+    def selectors(self, end: End) -> frozenset[str]:
+        """Letters of the robots known to have selected ``end`` if it is out, else none."""
+        i = self.numbering.end_index.get(end)
+        if i is None or not self._out >> i & 1:
+            return _NOBODY
+        return self._selectors(i)
+
+    def _selectors(self, i: int) -> frozenset[str]:
+        """Letters of the robots known to have selected the out end at position ``i``."""
+        chosen = self._selections
+        return frozenset([r for r, bit in self.numbering.choices[i].items() if chosen & bit])
 
     @property
     def n_ends(self) -> int:
         """Number of non-zero entries the matrix would have if fully explored."""
-        if self._n_ends is None:
-            self._n_ends = sum(map(len, self.rows.values()))
-        return self._n_ends
+        return self._ends.bit_count()
 
     def is_complete(self) -> bool:
         """Theorem 1: exploration is complete iff ``Eu`` and ``Eo`` are empty, i.e. every
         end of every known vertex belongs to a completed edge (Remark 5: the rightmost
         column of the ordered matrix is a completed one)."""
-        return len(self.completed) == self.n_ends
+        return self._completed.bit_count() == self._ends.bit_count()
 
     def unexplored(self) -> list[End]:
         """``Eu``: unexplored ends, in row order then angle order."""
-        completed, out = self.completed, self.out
-        return [
-            (tag, a)
-            for tag, angles in self.rows.items()
-            for a in angles
-            if (tag, a) not in completed and (tag, a) not in out
-        ]
+        row_ends, taken = self.numbering.row_ends, self._completed | self._out
+        return [(tag, a) for tag in self.rows for a, _, bit in row_ends[tag] if not taken & bit]
 
     def unexplored_at(self, tag: str) -> list[float]:
         """Angles of the unexplored edges at vertex ``tag`` (``Em(vj)`` for a beacon)."""
-        completed, out = self.completed, self.out
-        return [
-            a for a in self.rows.get(tag, ()) if (tag, a) not in completed and (tag, a) not in out
-        ]
+        n = self.numbering
+        if not self._tags & n.tag_bit.get(tag, 0):
+            return []
+        taken = self._completed | self._out
+        return [a for a, _, bit in n.row_ends[tag] if not taken & bit]
 
     def completed_edges(self) -> list[tuple[End, End]]:
         """``Ec``: each completed edge once, as its two ends."""
-        return [(e, f) for e, f in self.completed.items() if e < f]
+        ends, other = self.numbering.ends, self._others()
+        return [(ends[i], other[i]) for i in _positions(self._completed) if ends[i] < other[i]]
 
     def order(self) -> list[tuple[End, ...]]:
         """Algorithm 2: the columns, completed | out | unexplored, each column a tuple of
-        its ends. Completed and unexplored columns keep the order in which the merges met
-        them, as Algorithm 2's concatenation does; out columns go from most to least
+        its ends. Completed and unexplored columns keep the order in which the team first
+        wrote them, as Algorithm 2's concatenation does; out columns go from most to least
         selected, so that the rightmost is the next to help (Algorithm 4's shift)."""
-        out = sorted(self.out, key=lambda e: (-len(self.out[e]), e))
+        selectors = self.out
+        out = sorted(selectors, key=lambda e: (-len(selectors[e]), e))
         return [*self.completed_edges(), *((e,) for e in out), *((e,) for e in self.unexplored())]
 
     def to_array(self) -> tuple[list[str], list[tuple[End, ...]], np.ndarray]:
@@ -142,23 +333,40 @@ class IncidenceMatrix:
 
     # -- the completed graph Gc -----------------------------------------------------
 
-    def neighbours(self, tag: str) -> list[tuple[float, str]]:
-        """Completed edges at ``tag`` as ``(angle at tag, other tag)``, by angle."""
-        completed = self.completed
-        return [(a, completed[(tag, a)][0]) for a in self.rows[tag] if (tag, a) in completed]
+    def _others(self) -> list[End | None]:
+        """End position -> the other end of its edge, as this matrix knows it (read it
+        for completed ends only)."""
+        other = self.numbering.other
+        if self._moved:
+            other = other.copy()
+            for i, e in self._moved.items():
+                other[i] = e
+        return other
+
+    def layers(self, source: str, parents: dict[str, End | None] | None = None):
+        """Breadth-first layers of ``Gc`` from ``source``: lists of tags by hop distance,
+        each vertex's completed edges taken by angle. ``parents``, if given, receives for
+        each tag reached the end it was reached by (None for ``source``)."""
+        row_ends, done, other = self.numbering.row_ends, self._completed, self._others()
+        seen = {} if parents is None else parents
+        seen[source] = None
+        self._tree = (source, seen)  # the layers yielded so far are complete in it
+        layer = [source]
+        while layer:
+            yield layer
+            following = []
+            for t in layer:
+                for a, i, bit in row_ends[t]:
+                    if done & bit:
+                        u = other[i][0]
+                        if u not in seen:
+                            seen[u] = (t, a)
+                            following.append(u)
+            layer = following
 
     def distances(self, source: str) -> dict[str, int]:
         """Hop distances from ``source`` over the completed graph ``Gc`` (breadth first)."""
-        dist = {source: 0}
-        frontier = deque([source])
-        while frontier:
-            t = frontier.popleft()
-            d = dist[t] + 1
-            for _, u in self.neighbours(t):
-                if u not in dist:
-                    dist[u] = d
-                    frontier.append(u)
-        return dist
+        return {t: d for d, layer in enumerate(self.layers(source)) for t in layer}
 
     def nearest(self, source: str, targets: set[str]) -> set[str]:
         """The tags of ``targets`` fewest hops from ``source`` over ``Gc``."""
@@ -171,30 +379,24 @@ class IncidenceMatrix:
     def nearest_open(self, source: str) -> list[End]:
         """The unexplored ends fewest hops from ``source`` over ``Gc``; if no end is
         unexplored, the nearest out ends (empty when the exploration is complete)."""
-        completed, out, rows = self.completed, self.out, self.rows
-        nearest_out: list[End] = []
+        n, done, out = self.numbering, self._completed, self._out
+        row_mask, row_ends = n.row_mask, n.row_ends
+        nearest_out = 0
         for layer in self.layers(source):
-            ends = [(t, a) for t in layer for a in rows[t] if (t, a) not in completed]
-            unexplored = [e for e in ends if e not in out]
-            if unexplored:
-                return unexplored
-            if not nearest_out:
-                nearest_out = ends
-        return nearest_out
-
-    def layers(self, source: str):
-        """Breadth-first layers of ``Gc`` from ``source``: lists of tags by hop distance."""
-        seen = {source}
-        layer = [source]
-        while layer:
-            yield layer
-            following = []
+            ends = 0
             for t in layer:
-                for _, u in self.neighbours(t):
-                    if u not in seen:
-                        seen.add(u)
-                        following.append(u)
-            layer = following
+                ends |= row_mask[t]
+            open_ends = ends & ~done
+            if open_ends & ~out:
+                chosen = open_ends & ~out
+                break
+            if open_ends and not nearest_out:
+                nearest_out, at = open_ends, layer
+        else:
+            if not nearest_out:
+                return []
+            chosen, layer = nearest_out, at
+        return [(t, a) for t in layer for a, _, bit in row_ends[t] if chosen & bit]
 
     def route(self, source: str, target: str) -> list[End]:
         """A shortest path from ``source`` to ``target`` over ``Gc`` (Lemma 1 / Remark 4:
@@ -202,16 +404,15 @@ class IncidenceMatrix:
         paths, the one whose departures have the smallest angles, vertex by vertex."""
         if source == target:
             return []
-        parent: dict[str, End | None] = {source: None}
-        frontier = deque([source])
-        while frontier and target not in parent:
-            t = frontier.popleft()
-            for a, u in self.neighbours(t):
-                if u not in parent:
-                    parent[u] = (t, a)
-                    frontier.append(u)
-        if target not in parent:
-            raise ValueError(f"no completed path from {source} to {target}")
+        if self._tree is not None and self._tree[0] == source and target in self._tree[1]:
+            parent = self._tree[1]
+        else:
+            parent = {}
+            for _ in self.layers(source, parent):
+                if target in parent:
+                    break
+            else:
+                raise ValueError(f"no completed path from {source} to {target}")
         path: list[End] = []
         step = parent[target]
         while step is not None:
@@ -226,16 +427,37 @@ class IncidenceMatrix:
         """Eq. (5) / Algorithm 4 for an edge selected by ``robot`` (its beacon letters): an
         unexplored column is negated (made out); an out column records one more selector
         (see ``out``). A completed edge is left as it is."""
-        if end in self.completed or robot in self.out.get(end, ()):
+        n = _writable(self.numbering)
+        if n is not self.numbering:  # EMPTY's numbering is never written
+            return IncidenceMatrix({}, {}, {end: frozenset([robot])}, n)
+        i = n.end(end)
+        if self._completed >> i & 1:
             return self
-        selectors = self.out.get(end, _NOBODY) | {robot}
-        m = IncidenceMatrix(self.rows, self.completed, {**self.out, end: selectors})
-        m._n_ends = self._n_ends
+        choice = n.choice(i, robot)
+        if self._selections & choice:
+            return self
+        m = self._of(n, self._tags, self._ends, self._completed, self._out | 1 << i,
+                     self._selections | choice, self._moved, self._first)
+        m._tree = self._tree  # the same Gc
+        return m
+
+    def _renumbered(self, numbering: Numbering) -> IncidenceMatrix:
+        """The same matrix written in ``numbering``."""
+        m = IncidenceMatrix(self.rows, self.completed, self.out, numbering)
+        m._first = self._first
         return m
 
 
+#: The numbering of ``EMPTY``, never written.
+_NONE = Numbering()
+
 #: ``I0(Rk)`` of eq. (14): a robot at the start knows nothing.
-EMPTY = IncidenceMatrix({}, {}, {})
+EMPTY = IncidenceMatrix._of(_NONE, 0, 0, 0, 0, 0, _UNMOVED, None)
+
+
+def _writable(numbering: Numbering | None) -> Numbering:
+    """``numbering``, or a new one if None or ``EMPTY``'s (which stays empty)."""
+    return Numbering() if numbering is None or numbering is _NONE else numbering
 
 
 def merge(a: IncidenceMatrix, b: IncidenceMatrix) -> IncidenceMatrix:
@@ -246,51 +468,62 @@ def merge(a: IncidenceMatrix, b: IncidenceMatrix) -> IncidenceMatrix:
     completed over out over unexplored (Algorithm 1: differing signs become negative; a
     completed column replaces the other copy); a common out edge keeps the selectors of
     both copies. The result is equations (2) and (3) for ``Gc``, ``Eo`` and ``Eu``.
-    Merging is commutative in content; the operand with more completed edges is laid out
-    first (it is cheaper to copy), and an operand that already contains the other is
-    returned as it is (the order inside a block carries no information).
+    Merging is commutative in content, and an operand that already contains the other is
+    returned as it is. Two details matter only where operands disagree on the other end
+    of a completed end (after a beacon was wiped and dropped again): the operand with
+    fewer completed ends wins, and a one-edge matrix (Algorithm 3's ``I'``) counts as
+    contained when the other operand knows its rows and its first end as completed.
     """
     if a is b or b is EMPTY:
         return a
     if a is EMPTY:
         return b
-    if len(a.completed) < len(b.completed):
-        a, b = b, a
-    if len(b.completed) == 2 and len(b.rows) == 2 and not b.out:
-        return _with_column(a, b)
+    if b.numbering is not a.numbering:
+        b = b._renumbered(a.numbering)
+    count_a, count_b = a._completed.bit_count(), b._completed.bit_count()
+    if count_a < count_b:
+        a, b, count_b = b, a, count_a
+    if count_b == 2 and b._tags.bit_count() == 2 and not b._out:
+        if a._completed >> a.numbering.end_index[b._first] & 1 and not b._tags & ~a._tags:
+            return a
+        return _union(a, b)
     if _contains(a, b):
         return a
-    if len(a.completed) == len(b.completed) and _contains(b, a):
+    if count_a == count_b and _contains(b, a):
         return b
-    completed = a.completed | b.completed
-    out = {e: who for e, who in a.out.items() if e not in completed}
-    for e, who in b.out.items():
-        if e not in completed:
-            out[e] = out[e] | who if e in out else who
-    return IncidenceMatrix(a.rows | b.rows, completed, out)
+    return _union(a, b)
 
 
-def _with_column(a: IncidenceMatrix, column: IncidenceMatrix) -> IncidenceMatrix:
-    """``merge(a, column)`` for a one-edge ``I'`` (Algorithm 3's first merge), without
-    copying what does not change."""
-    end = next(iter(column.completed))
-    if end in a.completed and column.rows.keys() <= a.rows.keys():
-        return a
-    completed = a.completed | column.completed
-    rows = a.rows if column.rows.keys() <= a.rows.keys() else a.rows | column.rows
-    out = a.out
-    if any(e in out for e in column.completed):
-        out = {e: who for e, who in out.items() if e not in completed}
-    m = IncidenceMatrix(rows, completed, out)
-    if rows is a.rows:
-        m._n_ends = a._n_ends
-    return m
+def _union(a: IncidenceMatrix, b: IncidenceMatrix) -> IncidenceMatrix:
+    """Algorithm 1's union of two matrices of one numbering (``b``'s other ends win)."""
+    done = a._completed | b._completed
+    selections = a._selections | b._selections
+    settled = (a._out & b._completed) | (b._out & a._completed)
+    if settled:  # out on one side, completed on the other: the selections go
+        choice_mask = a.numbering.choice_mask
+        while settled:
+            low = settled & -settled
+            selections &= ~choice_mask[low.bit_length() - 1]
+            settled ^= low
+    moved = _UNMOVED
+    if a._moved or b._moved:
+        moved = {i: e for i, e in a._moved.items() if not b._completed >> i & 1}
+        moved.update(b._moved)
+    return IncidenceMatrix._of(
+        a.numbering, a._tags | b._tags, a._ends | b._ends, done, (a._out | b._out) & ~done,
+        selections, moved, a._first if a._completed else b._first)
 
 
 def _contains(a: IncidenceMatrix, b: IncidenceMatrix) -> bool:
-    """True if every entry of ``b`` is in ``a`` with at least ``b``'s status."""
-    return (
-        b.rows.keys() <= a.rows.keys()
-        and b.completed.keys() <= a.completed.keys()
-        and all(e in a.completed or who <= a.out.get(e, _NOBODY) for e, who in b.out.items())
-    )
+    """True if every entry of ``b`` is in ``a`` with at least ``b``'s status (both of one
+    numbering)."""
+    if b._tags & ~a._tags or b._completed & ~a._completed:
+        return False
+    missing = b._selections & ~a._selections
+    if missing:  # selections of ends a knows as completed do not count
+        choice_mask, settled = a.numbering.choice_mask, b._out & a._completed
+        while settled:
+            low = settled & -settled
+            missing &= ~choice_mask[low.bit_length() - 1]
+            settled ^= low
+    return not missing

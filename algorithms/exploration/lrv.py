@@ -47,7 +47,7 @@ class LRV(MapStrategy):
             visits[self.arrival] = visits.get(self.arrival, 0) + 1
         if self.matrix.is_complete():
             return DONE
-        order = ccw_from(self.arrival, self.matrix.rows[self.here])
+        order = ccw_from(self.arrival, self.matrix.angles(self.here))
         if self.rng is not None:
             order = [order[i] for i in self.rng.permutation(len(order))]
         choice = min(order, key=lambda a: visits.get(a, 0))

@@ -47,7 +47,11 @@ class MapStrategy(Strategy):
 
     After :meth:`first_step`, ``self.here`` is the tag of the current vertex,
     ``self.arrival`` the angle (at this vertex) of the edge the robot came by, or 2*pi
-    (the +x reference) when it did not move; ``self.matrix`` is ``In(Rk)``.
+    (the +x reference) when it did not move; ``self.matrix`` is ``In(Rk)``. The matrices
+    a robot writes use its matrix's numbering
+    (:class:`~algorithms.exploration.incidence_matrix.Numbering`): the robot that drops the
+    first beacon starts one, the others take it with the first beacon they read, so a team
+    shares one.
     """
 
     record_type: type[VertexRecord] = VertexRecord
@@ -75,19 +79,21 @@ class MapStrategy(Strategy):
         if record is None:
             self._dropped += 1
             beacon.id = tag = beacon_id(self.index, self._dropped)
-            row = tuple(sorted(normalize_angle(a) for a in angles))
-            record = beacon.data = self.new_record(IncidenceMatrix.initial(tag, row))
+            row = tuple(sorted(map(normalize_angle, angles)))
+            record = beacon.data = self.new_record(
+                IncidenceMatrix.initial(tag, row, self.matrix.numbering))
             before = None
             self.stored_angles = None
         else:
             tag = beacon.id
             before = record.matrix
-            row = self.stored_angles = before.rows[tag]
+            row = self.stored_angles = before.angles(tag)
         matrix = self.matrix
         if arrived_by is not None and self._left_by is not None:
             self.arrival = match_angle(normalize_angle(arrived_by), row)
             left = self._left_by
-            column = IncidenceMatrix.edge(left, matrix.rows[left[0]], (tag, self.arrival), row)
+            column = IncidenceMatrix.edge(left, matrix.angles(left[0]), (tag, self.arrival), row,
+                                          matrix.numbering)
             matrix = merge(column, matrix)
         else:
             self.arrival = TWO_PI

@@ -98,7 +98,7 @@ class MRDFS(MapStrategy):
             return self._move(record, self.arrival, FINISHING)
         children = [
             a
-            for a in ccw_from(self.arrival, self.matrix.rows[self.here])
+            for a in ccw_from(self.arrival, self.matrix.angles(self.here))
             if a != record.parent and a not in record.finished
         ]
         if self.rng is not None:

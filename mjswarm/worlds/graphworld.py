@@ -85,8 +85,8 @@ def outcome(
     per_robot = [len(p) - 1 for p in paths]
     map_edges: list[tuple[str, str]] = []
     if declared is not None:
-        map_edges = sorted(tuple(sorted((beacon_vertex[a], beacon_vertex[b])))
-                           for a, b in minds[declared[1]].map_edges())
+        pairs = ((beacon_vertex[a], beacon_vertex[b]) for a, b in minds[declared[1]].map_edges())
+        map_edges = sorted((u, v) if u <= v else (v, u) for u, v in pairs)
     return dict(
         run,
         strategy=getattr(minds[0], "name", type(minds[0]).__name__),
@@ -147,6 +147,11 @@ class GraphWorld:
             self.duration[(u, v)] = self.duration[(v, u)] = 1 if edge_time == "unit" else length / mean
         #: The true edge set, as sorted vertex pairs (metrics only).
         self.edges = {tuple(sorted(e)) for e in graph.edges}
+        #: vertex -> {angle: (neighbour, duration, angle of the edge at the neighbour)}: the
+        #: moves of :meth:`run`, worked out once for every run of the world.
+        self._exits: dict[str, dict[float, tuple[str, float, float]]] = {v: {} for v in graph}
+        for (v, a), u in self.towards.items():
+            self._exits[v][a] = (u, self.duration[(v, u)], self.angle_of[(u, v)])
 
     def explore(
         self,
@@ -179,6 +184,9 @@ class GraphWorld:
         k = len(minds)
         if max_time is None:
             max_time = 50 * (len(self.edges) + 1) + 100
+        angles, exits, unit = self.angles, self._exits, self.edge_time == "unit"
+        # the bookkeeping pass is skipped when every mind keeps Strategy's empty arrive()
+        bookkeeping = any(type(m).arrive is not Strategy.arrive for m in minds)
         beacons = {v: Beacon() for v in self.graph}
         beacon_vertex: dict[str, str] = {}
         position = [self.root] * k
@@ -195,20 +203,25 @@ class GraphWorld:
             batch = []  # every robot at a vertex at time t, in descending index
             while events and events[0][0] == t:
                 batch.append(-heapq.heappop(events)[1])
-            for i in batch:  # all bookkeeping first (a no-op for most strategies) ...
-                minds[i].arrive(beacons[position[i]], self.angles[position[i]], arrived_by[i])
+            if bookkeeping:  # all bookkeeping first ...
+                for i in batch:
+                    minds[i].arrive(beacons[position[i]], angles[position[i]], arrived_by[i])
             for i in batch:  # ... then the decisions, one after another
                 v = position[i]
                 beacon = beacons[v]
-                decision = minds[i].on_vertex(beacon, self.angles[v], arrived_by[i])
+                decision = minds[i].on_vertex(beacon, angles[v], arrived_by[i])
                 if beacon.id is not None and beacon.id not in beacon_vertex:
                     beacon_vertex[beacon.id] = v
                 if observer is not None:
                     observer(t, i, v, decision, minds[i])
                 if decision.action == "go":
-                    u = self._follow(v, decision.angle)
-                    done_at = self._clock(t + self.duration[(v, u)])
-                    position[i], arrived_by[i], arrival_time[i] = u, self.angle_of[(u, v)], done_at
+                    u, duration, back = (exits[v].get(decision.angle)
+                                         or self.nearest_exit(v, decision.angle))
+                    # times are whole steps with unit edges; with length-proportional
+                    # edges they are rounded to 1e-9 time units, so that arrivals equal up
+                    # to rounding errors are simultaneous (and handled in robot order)
+                    done_at = t + duration if unit else round(t + duration, 9)
+                    position[i], arrived_by[i], arrival_time[i] = u, back, done_at
                     paths[i].append(u)
                     heapq.heappush(events, (done_at, -i))
                 elif decision.action == "idle":
@@ -227,19 +240,11 @@ class GraphWorld:
             minds, declared, None if declared is None else declared[0], paths, beacon_vertex,
             self.edges, arena=arena, root=self.root, edge_time=self.edge_time, seed=seed))
 
-    def _clock(self, t: float) -> float:
-        """Times are whole steps with unit edges; with length-proportional edges they are
-        rounded to 1e-9 time units, so that arrivals equal up to rounding errors are
-        simultaneous (and handled in robot order)."""
-        return t if self.edge_time == "unit" else round(t, 9)
-
-    def _follow(self, vertex: str, angle: float) -> str:
-        """The neighbour along the edge at ``vertex`` nearest to ``angle``."""
-        u = self.towards.get((vertex, angle))
-        if u is not None:
-            return u
+    def nearest_exit(self, vertex: str, angle: float) -> tuple[str, float, float]:
+        """The move along the edge at ``vertex`` nearest to ``angle``: the neighbour, the
+        duration and the edge's angle at the neighbour."""
         best = min(self.angles[vertex], key=lambda a: angle_gap(a, angle))
-        return self.towards[(vertex, best)]
+        return self._exits[vertex][best]
 
 
 def make_minds(

@@ -41,7 +41,6 @@ import networkx as nx
 import numpy as np
 
 from algorithms.exploration import Beacon, Strategy
-from algorithms.exploration.base import angle_gap
 from algorithms.exploration.relay import ConnectedExplorer, Flooder
 from algorithms.exploration.tether import BASE, BaseStation, Tether, initial_parents
 from mjswarm.core.radio import Radio
@@ -148,7 +147,7 @@ class RadioGraphWorld:
                 if beacons[v].id is not None and beacons[v].id not in beacon_vertex:
                     beacon_vertex[beacons[v].id] = v
                 if decision.action == "go":
-                    u = self._follow(v, decision.angle)
+                    u = w.nearest_exit(v, decision.angle)[0]
                     at[i], edge[i], progress[i], arrived_by[i] = None, (v, u), 0.0, w.angle_of[(u, v)]
                 elif decision.action == "idle":
                     arrived_by[i], wake[i] = None, tick + TICKS_PER_UNIT
@@ -209,11 +208,6 @@ class RadioGraphWorld:
             cut_ticks=cut, biconnected_share=1.0 - fragile / max(ticks, 1),
             fragile_ticks=fragile, relay_trips=sum(r.relay_trips for r in robots),
             infeasible=infeasible is not None, reason=reason)
-
-    def _follow(self, vertex: str, angle: float) -> str:
-        """The neighbour along the edge at ``vertex`` nearest to ``angle``."""
-        w = self.world
-        return w.towards[(vertex, min(w.angles[vertex], key=lambda a: angle_gap(a, angle)))]
 
     def _step(self, e: tuple[str, str], progress: float) -> tuple[float, float]:
         """The displacement (m) a robot on edge ``e`` makes in one tick."""
