@@ -155,9 +155,7 @@ def test_cli_reports_the_constraint(tmp_path, capsys):
 
 @pytest.mark.parametrize("argv,message", [
     (["--connectivity", "connected", "--world", "graph"], "needs --radio-range"),
-    (["--connectivity", "connected", "--radio-range", "1", "--world", "embodied"],
-     "graph world only so far"),
-    (["--radio-range", "-1", "--world", "graph"], "--radio-range must be positive"),
+    (["--radio-range", "-1", "--world", "graph"], "radio range must be positive"),
 ])
 def test_cli_bad_input_is_one_line(capsys, argv, message):
     assert main(["explore", "--arena", "fig9", "--robots", "2", *argv]) == 2
@@ -182,3 +180,42 @@ def test_the_readme_table_script_runs():
     lines = module.rows(["fig9"], [2], [1.0, 50.0])
     assert len(lines) == 4 and lines[2].startswith("| fig9 | 2 | 1 |")
     assert lines[3].count("/ 0 |") >= 2  # at 50 m nobody needs a relay
+
+
+# ---------------------------------------------------------------------------- embodied
+def embodied(arena: str, robots: int, range_m: float, **config):
+    from mjswarm.experiments.exploration import EmbodiedConfig, explore_embodied
+
+    return explore_embodied(load_arena(arena), robots, config=EmbodiedConfig(
+        radio_range_m=range_m, connectivity="connected", **config))
+
+
+def test_embodied_with_range_to_spare_changes_nothing():
+    """arena1, 2 robots, 3 m: the tether never binds, the run is the unconstrained one
+    (5 / 10, 237.9 s), with 0 contacts and every robot linked to the base every tick."""
+    result = embodied("arena1", 2, 3.0)
+    assert result.completed and result.map_correct
+    assert (result.makespan, result.total_traversals) == (5, 10)
+    assert result.collisions == 0 and result.cut_ticks == 0 and result.connected_share == 1.0
+
+
+def test_embodied_too_short_a_range_ends_in_a_verdict():
+    """1.5 m: walls cut links the leash cannot foresee; the robots back out of each cut
+    (a few ticks), and the team declares itself infeasible instead of running on."""
+    result = embodied("arena1", 2, 1.5, speed_m_s=0.1)
+    assert result.infeasible and not result.completed
+    assert result.reason.startswith("infeasible with 2 robots at range 1.5 m: explored ")
+    assert result.collisions == 0
+    assert result.connected_share > 0.999
+
+
+def test_a_wall_hides_a_robot_from_the_base_mast():
+    """Line of sight from a fixed antenna (the base's mast): a wall between blocks it, and
+    a mast above the wall sees over it."""
+    from mjswarm.core.simulation import Simulation
+    from mjswarm.core.world import Pose2D, WallSegment, world_spec
+
+    sim = Simulation(world_spec([Pose2D(1.0, 0.0)], walls=[WallSegment((0.5, -1), (0.5, 1))]))
+    assert not sim.sight.from_point((0.0, 0.0), [0])[0]
+    assert sim.sight.from_point((0.0, 0.0), [0], height_m=3.0)[0]
+    assert sim.sight.from_point((2.0, 0.0), [0])[0]

@@ -10,7 +10,17 @@ It composes, fed only by its own observation:
   from its bearings while it follows a lane;
 * vertex entry (:mod:`algorithms.exploration.entry`) with the stations;
 * optionally a :class:`~algorithms.connectivity.ConnectivityTable` (seed 004) kept over
-  its radio: its belief whether a single robot's loss would cut it off the reference.
+  its radio: its belief whether a single robot's loss would cut it off the reference;
+* optionally a :class:`~algorithms.exploration.tether.Tether` (issue 17's connected
+  exploration, rules 1-5): it reads its radio neighbours' ranges and bearings
+  (``Observation.detections``), and it does not drive a control period's distance
+  (``v dt`` ahead) that the leash forbids: it stands (no turn either, so that it keeps its
+  lane), asks for adoption, and declares the exploration infeasible on a stall (rule 5),
+  after which it stands for good. The leash knows ranges, not walls: when a wall comes
+  between it and a parent (the link is gone from its radio neighbours), it drives its
+  moves since the link was last there backwards, and then stands as if the leash had
+  stopped it until it has a new parent (ours). Relays on demand (rule 6) are not part of
+  the embodied explorer yet.
 
 Choices beyond the paper (the loop functions in :mod:`mjswarm.experiments.exploration` say the rest):
 
@@ -36,6 +46,7 @@ from typing import Any, NamedTuple
 
 from algorithms.collision import CollisionRule
 from algorithms.exploration.base import AngleMismatch, Decision, Strategy
+from algorithms.exploration.tether import Tether
 from algorithms.exploration.entry import (
     STATION,
     EntryDenied,
@@ -71,12 +82,14 @@ class Explorer(Controller):
         idle_wait_s: how long to wait before asking an idle strategy again.
         table: a connectivity table kept over the radio (None: none).
         control_dt_s: its control period (its clock counts ticks for the table).
+        tether: its tether to the base (None: exploration without the constraint).
     """
 
     def __init__(self, strategy: Strategy, calibration: RobotCalibration,
                  conventions: ArenaConventions, speed_m_s: float,
                  rule: CollisionRule | None, turn_rate_rad_s: float = 1.0,
-                 idle_wait_s: float = 2.0, table=None, control_dt_s: float = 0.02) -> None:
+                 idle_wait_s: float = 2.0, table=None, control_dt_s: float = 0.02,
+                 tether: Tether | None = None) -> None:
         self.strategy = strategy
         self.calibration, self.conventions = calibration, conventions
         self.cruise_m_s = speed_m_s
@@ -84,6 +97,13 @@ class Explorer(Controller):
         self.turn_rate_rad_s = turn_rate_rad_s
         self.idle_wait_s = idle_wait_s
         self.table = table
+        self.tether = tether
+        #: whether its tether declared the exploration infeasible (rule 5)
+        self.infeasible = False
+        self._progressed = False
+        self._trail: list[tuple[float, float]] = []  # moves since its parents were all linked
+        self._occluded = False  # lost a parent's link to a wall: waits for a new parent
+        self._parents_then = None if tether is None else tether.parents
         self.control_dt_s = control_dt_s
         self.nav = Navigator(calibration, conventions, 0.0, speed_m_s, turn_rate_rad_s)
         #: every vertex call so far (for the loop functions' metrics and recordings)
@@ -106,15 +126,66 @@ class Explorer(Controller):
 
     def step(self, observation: Observation) -> Command:
         out: list[Message] = []
+        now = round(observation.time_s / self.control_dt_s)
         if self.table is not None:
-            now = round(observation.time_s / self.control_dt_s)
             robots = [m for m in observation.inbox if m.sender != STATION]
             out += self.table.tick(now, robots, observation.neighbors)
+        around = {}
+        if self.tether is not None:
+            around = {j: (d.range_m * math.cos(d.bearing_rad), d.range_m * math.sin(d.bearing_rad))
+                      for j, d in observation.detections.items()}
+            tied = [m for m in observation.inbox if m.sender != STATION]
+            out += self.tether.hear(now, tied, around)
         for m in observation.inbox:
             if m.sender == STATION:
                 self._from_station(m.payload, out)
-        if self.halted is not None or self.declared:
-            return Command(messages=tuple(out))
+        if self.halted is not None or self.declared or self.infeasible:
+            return self._stand(now, out, around)
+        if self.tether is not None and not all(q in around for q in self.tether.parents):
+            return self._retrace(now, out, around)
+        command = self._drive(observation, out)
+        if self.tether is None:
+            return command
+        wanted = None
+        if command.v_m_s != 0.0:
+            step = (command.v_m_s * self.control_dt_s, 0.0)  # in its own frame
+            if self._occluded or not self.tether.may_step(step, around):
+                wanted, command = step, Command(messages=command.messages)
+            else:
+                self._trail.append((command.v_m_s, command.omega_rad_s))
+        if self.tether.parents != self._parents_then:  # a new parent: try again
+            self._occluded, self._trail = False, []
+        self._parents_then = self.tether.parents
+        out = list(command.messages)
+        out += self.tether.ask(now, wanted, around)
+        out.append(self.tether.beat(now, command.v_m_s != 0.0, self._progressed,
+                                    len(self.strategy.map_edges())))
+        self._progressed = False
+        if self.tether.stalled(now):
+            self.infeasible = True
+        return command._replace(messages=tuple(out))
+
+    def _retrace(self, now: int, out: list[Message], around) -> Command:
+        """A parent's link is gone (a wall came between them: the leash knows ranges, not
+        walls): drive its last moves backwards until the link is back, then wait for a new
+        parent as if the leash had stopped it."""
+        self._occluded = True
+        if not self._trail:
+            return self._stand(now, out, around)
+        v, w = self._trail.pop()
+        out.append(self.tether.beat(now, True, False, len(self.strategy.map_edges())))
+        return Command(-v, -w, messages=tuple(out))
+
+    def _stand(self, now: int, out: list[Message], around) -> Command:
+        """Stand still (stopped, done, or infeasible); a tethered robot keeps beating, so
+        that its children and the stall gossip go on."""
+        if self.tether is not None:
+            out += self.tether.ask(now, None, around)
+            out.append(self.tether.beat(now, False, False, len(self.strategy.map_edges())))
+        return Command(messages=tuple(out))
+
+    def _drive(self, observation: Observation, out: list[Message]) -> Command:
+        """Navigator, vertex calls, the speed rule and vertex entry: this tick's command."""
         v, w = self.nav.update(percept(observation.line_m, observation.ir_m,
                                        observation.encoder_rad, self.calibration.line_floor_m))
         self._on_events(observation, out)
@@ -180,6 +251,7 @@ class Explorer(Controller):
         if self.strategy.stored_angles is not None:  # re-anchoring
             nav.reanchor(self.strategy.stored_angles)
         self.calls.append(VertexCall(observation.time_s, beacon, arrived, decision))
+        self._progressed = arrived
         if decision.action == "go":
             self._departure = min(nav.edge_angles, key=lambda a: abs(
                 math.remainder(a - decision.angle, 2 * math.pi)))

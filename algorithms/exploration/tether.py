@@ -223,14 +223,14 @@ class Tether:
         return math.hypot(offset[0] - step[0], offset[1] - step[1]) <= self.leash_m
 
 
-def initial_parents(robot: int, need: int) -> tuple[tuple, bool]:
-    """Parents at the start, all robots standing on the root, and whether they are pinned:
-    with ``need`` 1, the base; with 2, the base and the first robot, which keeps the base
-    as its only parent for good (so the base and it form the biconnected core every
-    other robot hangs from by two distinct parents: rule 1 for ``biconnected``)."""
+def initial_parents(robot: int, need: int, first: int = 0) -> tuple[tuple, bool]:
+    """Parents on the root at the start, and whether they are pinned: with ``need`` 1, the
+    base; with 2, the base and the ``first`` robot on the root, which keeps the base as its
+    only parent for good (so the base and it form the biconnected core every other robot
+    hangs from by two distinct parents: rule 1 for ``biconnected``)."""
     if need == 1:
         return (BASE,), False
-    return ((BASE,), True) if robot == 0 else ((BASE, 0), False)
+    return ((BASE,), True) if robot == first else ((BASE, first), False)
 
 
 class BaseStation:

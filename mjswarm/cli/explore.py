@@ -74,7 +74,8 @@ def run_embodied(args) -> dict:
         stall_timeout_s=args.stall_timeout,
         faults=[parse_fault(f) for f in args.fault or ()],
         line_noise_m=_or(args.line_noise, 0.0), ir_noise_m=_or(args.ir_noise, 0.0),
-        wheel_slip=_or(args.wheel_slip, 0.0), physics=args.physics or defaults.physics)
+        wheel_slip=_or(args.wheel_slip, 0.0), physics=args.physics or defaults.physics,
+        connectivity=args.connectivity or "none")
     run = EmbodiedExploration(spec, make_minds(args.strategy, args.robots, args.seed), config,
                               args.seed)
     with ExitStack() as outputs:
@@ -140,8 +141,9 @@ def register(subparsers) -> None:
                         help="none: explore as seed 003 (default); connected: every robot "
                              "keeps a radio route to the base at the root; biconnected: two "
                              "disjoint routes, so that one robot failing cuts nobody off. "
-                             "Needs --radio-range; graph world only so far. A team that "
-                             "cannot go on says so (infeasible) and stops")
+                             "Needs --radio-range. A team that cannot go on says so "
+                             "(infeasible) and stops. Relays on demand: graph world only "
+                             "so far")
     parser.add_argument("--radio-range", type=float, default=None, metavar="M",
                         help="radio range, m. Graph world: robots and a base at the root "
                              "talk within it (walls ignored), and the result reports "
@@ -223,13 +225,10 @@ def check_options(args) -> None:
     elif args.edge_time is not None:
         raise MjswarmError("--edge-time only applies to the graph world (--world graph)")
     if args.connectivity not in (None, "none"):
-        if args.world != "graph":
-            raise MjswarmError(f"--connectivity {args.connectivity} runs in the graph world "
-                               "only so far (--world graph)")
         if args.radio_range is None:
             raise MjswarmError(f"--connectivity {args.connectivity} needs --radio-range")
     if args.radio_range is not None and not args.radio_range > 0:
-        raise MjswarmError(f"--radio-range must be positive, got {args.radio_range:g} m")
+        raise MjswarmError(f"radio range must be positive, got {args.radio_range:g} m")
     if args.max_time is not None and not args.max_time > 0:
         raise MjswarmError(f"--max-time must be positive, got {args.max_time:g}")
     if args.launch_interval is not None and not args.launch_interval >= 0:
@@ -252,7 +251,7 @@ def summary(result: dict) -> str:
     head = (f"{result['arena']}: {result['robots']} robot(s), {result['strategy']}, "
             f"{result['world']} world, root {result['root']}")
     radio = []
-    if result.get("connectivity") is not None:
+    if "radio_range_m" in result:
         radio = [f"radio {result['radio_range_m']:g} m, connectivity {result['connectivity']}: "
                  f"{result['messages']} messages, {result['relay_trips']} relay trips; every "
                  f"robot reached the base in {100 * result['connected_share']:.1f} % of the "
@@ -286,6 +285,11 @@ def summary(result: dict) -> str:
         lines += [f"stopped: R{s['robot']} at {s['at_s']:.1f} s: {s['reason']}"
                   for s in result["stopped_robots"]]
         lines += [f"fault: {f['fault']} at {f['at_s']:.1f} s" for f in result["faults"]]
+        if result["connectivity"] != "none":
+            lines.append(
+                f"connectivity {result['connectivity']}: every robot reached the base in "
+                f"{100 * result['connected_share']:.1f} % of the ticks ({result['cut_ticks']} "
+                f"cut), biconnected in {100 * result['biconnected_share']:.1f} %")
         if result["radio_messages"] is not None:
             lines.append(
                 f"radio: {result['radio_messages']} messages (busiest robot "

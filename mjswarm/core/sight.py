@@ -67,6 +67,25 @@ class LineOfSight:
             where = self._find(key)
         return self._seen[where]
 
+    def from_point(self, point: tuple[float, float], robots: np.ndarray,
+                   height_m: float = RAY_HEIGHT_M) -> np.ndarray:
+        """Whether each robot is seen from a fixed antenna at ``point`` (m), ``height_m``
+        above the floor (a base station's mast): a ray from the antenna towards the robot's
+        centre at ``RAY_HEIGHT_M`` must hit the robot first; nothing is excluded."""
+        sim = self.sim
+        robots = np.asarray(robots, np.int64)
+        poses = sim.poses()
+        start = np.array([point[0], point[1], height_m], float)
+        vec = np.column_stack([poses[robots, :2], np.full(len(robots), RAY_HEIGHT_M)]) - start
+        dist = np.linalg.norm(vec, axis=1)
+        unit = vec / np.where(dist > 0, dist, 1.0)[:, None]
+        unit[dist == 0] = (1.0, 0.0, 0.0)
+        self.rays_cast += len(robots)
+        _, geom = sim.rays.cast(Rays(np.tile(start, (len(robots), 1)), unit,
+                                     dist + sim.rays.robot_radius_m, np.full(len(robots), -1)),
+                                _COLLISION)
+        return (geom >= 0) & (sim.geom_robot[geom] == robots)
+
     def _find(self, key: np.ndarray) -> np.ndarray:
         """Index of each key among the answered ones, -1 where not answered yet."""
         if not len(self._keys):

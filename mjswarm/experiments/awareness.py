@@ -14,11 +14,12 @@ the *truth* is :func:`truth`.
 
 from __future__ import annotations
 
-from collections.abc import Hashable, Iterable
+from collections.abc import Hashable, Iterable, Mapping
 
 import networkx as nx
 import numpy as np
 
+from algorithms.robot import NOTHING
 from mjswarm.core.radio import Blocker
 from mjswarm.core.simulation import Simulation
 
@@ -33,13 +34,31 @@ def truth(graph: nx.Graph, reference: Hashable, robots: Iterable[Hashable]) -> d
     return {i: BICONNECTED if any(i in c for c in blocks) else NOT for i in robots}
 
 
-def sight_blocker(sim: Simulation) -> Blocker:
+def sight_blocker(sim: Simulation, fixed: Mapping[Hashable, tuple[float, float]] = NOTHING,
+                  mast_m: float = 0.0) -> Blocker:
     """The radio's line-of-sight test on a simulation: a link between robots i and j is
-    blocked unless each sees the other (:attr:`Simulation.sight` both ways)."""
+    blocked unless each sees the other (:attr:`Simulation.sight` both ways); a link
+    between a robot and a fixed node (a base station at ``fixed[address]``, m, its antenna
+    ``mast_m`` above the floor) unless the robot is seen from the antenna."""
 
-    def blocked(pairs: np.ndarray) -> np.ndarray:
+    def between_robots(pairs: np.ndarray) -> np.ndarray:
         i, j = np.asarray(pairs, np.int64).reshape(-1, 2).T
         seen = sim.sight(np.concatenate([i, j]), np.concatenate([j, i]))
         return ~(seen[: len(i)] & seen[len(i):])
+
+    if not fixed:
+        return between_robots
+
+    def blocked(pairs: np.ndarray) -> np.ndarray:
+        pairs = np.asarray(pairs).reshape(-1, 2)
+        cut = np.zeros(len(pairs), bool)
+        robots = np.array([not (a in fixed or b in fixed) for a, b in pairs], bool)
+        if robots.any():
+            cut[robots] = between_robots(pairs[robots])
+        for k in np.flatnonzero(~robots):
+            a, b = pairs[k]
+            node, robot = (a, b) if a in fixed else (b, a)
+            cut[k] = robot in fixed or not sim.sight.from_point(fixed[node], [robot], mast_m)[0]
+        return cut
 
     return blocked

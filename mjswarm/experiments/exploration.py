@@ -36,6 +36,14 @@ injects faults, measures and records. Choices it makes, beyond the paper:
   biconnected component of three or more with R1 in the radio graph; both are sampled
   five times a second into ``radio_belief_agreement``. Robots in the depot or failed
   are off the air.
+* **Exploration that stays connected** (``connectivity``, issue 17): a base station at
+  the root joins the robots' radio (links need line of sight, as between robots); every
+  robot keeps its tether (:mod:`algorithms.exploration.tether`) from a radio-ranging
+  sensor (range and bearing of its radio neighbours); the base adopts, beats and floods
+  on. Relays on demand (rule 6) run in the graph world only so far. Ground truth every
+  tick: networkx on the radio graph with the base (``cut_ticks``, ``fragile_ticks``).
+  The robots' own stall verdict (rule 5) replaces the ``stall_timeout_s`` check.
+  Tables (connectivity awareness) are off in these runs.
 * **Metrics**: ``makespan`` is the largest number of edges any robot had traversed when
   completion was declared (the synchronous world's step count; seed 003 counts "edge
   traversals"), ``total_traversals`` the sum; ``collisions`` are robot-robot contact events
@@ -52,6 +60,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+import networkx as nx
 import numpy as np
 from tqdm import tqdm
 
@@ -68,6 +77,8 @@ from algorithms.exploration.entry import (
     VertexClear,
 )
 from algorithms.exploration.explorer import Explorer, VertexCall
+from algorithms.exploration.relay import Flooder
+from algorithms.exploration.tether import BASE, BaseStation, Tether, initial_parents
 from algorithms.navigation import NavigatorState
 from mjswarm.arena import ArenaSpec
 from mjswarm.arena.builder import arena_world_spec
@@ -78,6 +89,7 @@ from mjswarm.core.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.faults import Fault
 from mjswarm.worlds.graphworld import ExplorationResult, make_minds, outcome
+from mjswarm.worlds.radiograph import CONNECTIVITY, NEED
 from mjswarm.outputs.recording import contact_event
 from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.navigation import calibration, conventions
@@ -87,6 +99,12 @@ from mjswarm.worlds.sparkworld import SparkWorld
 from mjswarm.experiments.stations import VertexStations
 from mjswarm.core.world import Pose2D
 
+#: The tether's leash keeps parents within the radio range less this (m): a control
+#: period's drive at top speed (4 mm), turns and the one-tick-old ranging, with room.
+TETHER_MARGIN_M = 0.02
+#: Height (m) of the base station's antenna at the root: above the robots (0.07 m tall),
+#: so that a robot standing on the root does not shadow the others; walls still block.
+BASE_MAST_M = 1.0
 #: A robot is on a vertex when within this distance of its centre (m).
 ON_VERTEX_M = 0.05
 #: The root counts as free for a launch when no active robot is this close to it (m).
@@ -128,6 +146,9 @@ class EmbodiedConfig:
         wheel_slip: scale of the wheel-slip model (:class:`mjswarm.core.simulation.Simulation`).
         physics: ``"dynamic"`` (MuJoCo's contact physics) or ``"kinematic"`` (the fast
             tier, :mod:`mjswarm.core.kinematic`).
+        connectivity: ``"none"``, or ``"connected"`` / ``"biconnected"`` (needs
+            ``radio_range_m``): every robot keeps its tether to a base station at the root
+            (:mod:`algorithms.exploration.tether`; see the module docstring).
     """
 
     speed_m_s: float = PAPER_SPEED_M_S
@@ -148,6 +169,7 @@ class EmbodiedConfig:
     ir_noise_m: float = 0.0
     wheel_slip: float = 0.0
     physics: str = "dynamic"
+    connectivity: str = "none"
 
 
 @dataclass
@@ -180,6 +202,17 @@ class EmbodiedResult(ExplorationResult):
     #: vertex-entry messages between robots and stations, both ways
     #: (:mod:`algorithms.exploration.entry`)
     station_messages: int = 0
+    #: the connectivity constraint, and the ground truth on it: ticks (with a robot on the
+    #: floor) in which some robot had no radio route to the base, or the radio graph with
+    #: the base was not biconnected, and their shares
+    connectivity: str = "none"
+    cut_ticks: int = 0
+    fragile_ticks: int = 0
+    connected_share: float | None = None
+    biconnected_share: float | None = None
+    #: whether the robots declared the exploration infeasible (rule 5 of the tether)
+    infeasible: bool = False
+    reason: str | None = None
 
 
 def same_lane_bearing(range_m: float) -> float:
@@ -212,6 +245,12 @@ class EmbodiedExploration(LoopFunctions):
             raise MjswarmError(f"need {k} epsilons, got {len(eps)}")
         if config.radio_range_m is not None and not config.radio_range_m > 0:
             raise MjswarmError(f"radio range must be positive, got {config.radio_range_m} m")
+        if config.connectivity not in CONNECTIVITY:
+            raise MjswarmError(f"connectivity must be one of {', '.join(CONNECTIVITY)}, "
+                               f"got '{config.connectivity}'")
+        tied = config.connectivity != "none"
+        if tied and config.radio_range_m is None:
+            raise MjswarmError(f"connectivity {config.connectivity} needs a radio range")
         self.spec, self.minds, self.config, self.seed = spec, minds, config, seed
         self.recorder = recorder
         xs = [x for x, _ in spec.vertices.values()]
@@ -230,12 +269,18 @@ class EmbodiedExploration(LoopFunctions):
             self.sim, math.radians(config.bearing_fov_deg), config.bearing_range_m,
             math.radians(config.bearing_noise_deg), seed=seed or 0)
         self.world = SparkWorld(self.sim, bearing, present=np.zeros(k, bool),
-                                beacon_at=self._beacon_at)
+                                beacon_at=self._beacon_at, ranging=tied)
         self.uplink = Uplink(STATION)
         self.world.uplinks[STATION] = self.uplink
+        self.base = None
+        if tied:  # the base station at the root, on the robots' radio
+            self.world.fixed = {BASE: tuple(spec.vertices[spec.root])}
+            self.base = BaseStation(Flooder())
         if config.radio_range_m is not None:
-            self.world.attach_radio(Radio(range(k), range_m=config.radio_range_m,
-                                          blocked=sight_blocker(self.sim)))
+            self.world.attach_radio(Radio([*range(k), *self.world.fixed],
+                                          range_m=config.radio_range_m,
+                                          blocked=sight_blocker(self.sim, self.world.fixed,
+                                                                BASE_MAST_M)))
         avoid = config.collision_avoidance
         cal, conv = calibration(geometry), conventions(geometry)
         self.robots = [
@@ -244,8 +289,9 @@ class EmbodiedExploration(LoopFunctions):
                                    same_lane=same_lane_bearing(config.bearing_range_m))
                      if avoid else None,
                      config.turn_rate_rad_s, config.idle_wait_s,
-                     ConnectivityTable(i, 0) if config.radio_range_m is not None else None,
-                     self.sim.control_dt_s)
+                     ConnectivityTable(i, 0) if config.radio_range_m is not None and not tied
+                     else None,
+                     self.sim.control_dt_s, self._tether(i, order[0]) if tied else None)
             for i, (mind, e) in enumerate(zip(minds, eps))]
         self.beacons = {v: Beacon() for v in spec.vertices}
         self.beacon_vertex: dict[str, str] = {}
@@ -270,6 +316,7 @@ class EmbodiedExploration(LoopFunctions):
         self.pending_faults = sorted(config.faults, key=lambda f: f.at_s)
         self.fault_log: list[dict] = []
         self.ended_because = "max time"
+        self.cut_ticks = self.fragile_ticks = self.tied_ticks = 0
         self.agree = self.samples = 0
         self._truth: dict[int, str] | None = None  # this tick's truth, on sampled ticks
         self._beliefs: dict[int, str] = {}
@@ -346,9 +393,11 @@ class EmbodiedExploration(LoopFunctions):
         """Whether the run is over (and why, in ``ended_because``)."""
         if self.declared is not None:
             self.ended_because = "completed"
+        elif any(r.infeasible for r in self.robots):
+            self.ended_because = self._infeasible_reason()
         elif all(self.done):
             self.ended_because = "all robots stopped"
-        elif self.sim.time_s - self.last_progress_s > self.stall_timeout_s:
+        elif self.base is None and self.sim.time_s - self.last_progress_s > self.stall_timeout_s:
             self.ended_because = "stalled"
         else:
             return False
@@ -359,7 +408,10 @@ class EmbodiedExploration(LoopFunctions):
         """Faults, launches, the stations' mail, grants; the radio's truth, five times a
         second."""
         radio = self.world.radio
-        if radio is not None and self.sim.step_count % 10 == 0 and self.sim.step_count:
+        if self.base is not None:
+            for m in self.base.step(radio.receive(BASE)):
+                radio.send(BASE, m.payload, m.to)
+        elif radio is not None and self.sim.step_count % 10 == 0 and self.sim.step_count:
             graph = radio.graph()
             self._truth = awareness_truth(graph, 0, range(1, len(self.robots)))
             self._links, self._beliefs = list(graph.edges), {}
@@ -400,6 +452,11 @@ class EmbodiedExploration(LoopFunctions):
         sim = self.sim
         if self._truth is not None:
             self._sample_beliefs()
+        if self.base is not None and any(self.world.present):
+            graph = self.world.radio.graph()  # ground truth, every tick
+            self.tied_ticks += 1
+            self.cut_ticks += not nx.is_connected(graph)
+            self.fragile_ticks += not nx.is_biconnected(graph)
         if self.recorder is not None:
             readings = sim.readings()
             bearings = self.world.bearing_readings()
@@ -584,6 +641,23 @@ class EmbodiedExploration(LoopFunctions):
             self._nearest_version = sim.state_version
         return self._vertex_ids[self._nearest[i]], float(self._nearest_m[i])
 
+    def _tether(self, i: int, first: int) -> Tether:
+        """Robot ``i``'s tether: a time unit is the mean edge at the run's speed (rule 5's
+        patience counts in them)."""
+        need = NEED[self.config.connectivity]
+        spec = self.spec
+        mean_m = float(np.mean([math.dist(spec.vertices[u], spec.vertices[v])
+                                for u, v in spec.edges]))
+        ticks = max(1, round(mean_m / self.config.speed_m_s / self.sim.control_dt_s))
+        return Tether(i, self.config.radio_range_m, *initial_parents(i, need, first),
+                      margin_m=TETHER_MARGIN_M, ticks_per_unit=ticks)
+
+    def _infeasible_reason(self) -> str:
+        explored = {tuple(sorted(e)) for p in self.paths for e in zip(p, p[1:])}
+        return (f"infeasible with {len(self.robots)} robots at range "
+                f"{self.config.radio_range_m:g} m: explored {len(explored)} of "
+                f"{len(self.spec.edges)} edges")
+
     def _event(self, i: int | None, text: str) -> None:
         if self.recorder is not None:
             self.recorder.log_event(self.sim.step_count, self.sim.time_s, text, i)
@@ -608,6 +682,14 @@ class EmbodiedExploration(LoopFunctions):
             radio_belief_agreement=(self.agree / self.samples if radio is not None
                                     and self.samples else None),
             station_messages=self.uplink.sent_up + self.uplink.sent_down,
+            connectivity=self.config.connectivity,
+            cut_ticks=self.cut_ticks,
+            fragile_ticks=self.fragile_ticks,
+            connected_share=(1.0 - self.cut_ticks / self.tied_ticks) if self.tied_ticks else None,
+            biconnected_share=(1.0 - self.fragile_ticks / self.tied_ticks) if self.tied_ticks
+            else None,
+            infeasible=any(r.infeasible for r in self.robots),
+            reason=self._infeasible_reason() if any(r.infeasible for r in self.robots) else None,
             ended_because=self.ended_because,
             stopped_robots=list(self.stopped),
             heading_error_deg=round(math.degrees(self.heading_error_rad), 3),

@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from algorithms.robot import Command, Controller, Message, Observation
+from algorithms.robot import NOTHING, Command, Controller, Message, Observation
 from mjswarm.errors import MjswarmError
 from mjswarm.core.radio import Radio
 
@@ -53,6 +53,9 @@ class World(ABC):
     uplinks: dict
     #: control period (s)
     control_dt_s: float
+    #: radio nodes that never move, by address: position (m) (a base station); the radio
+    #: knows them after the robots, in this order
+    fixed: Mapping = NOTHING
 
     @property
     @abstractmethod
@@ -96,9 +99,11 @@ class World(ABC):
 
     # -- the radio, shared by every world ----------------------------------------------
     def attach_radio(self, radio: Radio) -> None:
-        """Give every robot this radio (ids ``0 .. n - 1``); absent robots are off the air."""
-        if set(radio.robots) != set(range(self.n)):
-            raise MjswarmError("the radio must know exactly the robots 0 .. n - 1")
+        """Give every robot this radio (ids ``0 .. n - 1``, then the :attr:`fixed` nodes);
+        absent robots are off the air."""
+        if tuple(radio.robots) != tuple(range(self.n)) + tuple(self.fixed):
+            raise MjswarmError("the radio must know exactly the robots 0 .. n - 1, then the "
+                               "world's fixed nodes")
         self.radio = radio
         for i in range(self.n):
             if not self.present[i]:
@@ -119,8 +124,9 @@ class World(ABC):
             self.radio.move(self._air_positions())
 
     def _air_positions(self) -> np.ndarray:
-        """Where the robots are (metres), one row per robot: the radio's robots are 0 .. n - 1."""
-        return self.true_poses()[:, :2]
+        """Where the radio's nodes are (m): the robots 0 .. n - 1, then the fixed nodes."""
+        xy = self.true_poses()[:, :2]
+        return np.vstack([xy, list(self.fixed.values())]) if self.fixed else xy
 
     def _radio_step(self) -> None:
         """End of a tick: deliver this tick's messages, relink from the new positions."""

@@ -14,12 +14,13 @@ waiting in a depot off the arena are neither stepped nor on the air).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-from algorithms.robot import NOTHING, Command, Observation
+from algorithms.robot import NOTHING, Command, Detection, Observation
 from mjswarm.core.bearing import BearingSensor
 from mjswarm.worlds.loop import World
 from mjswarm.core.simulation import Simulation
@@ -32,11 +33,14 @@ class SparkWorld(World):
         present: which robots are on the floor (default all).
         beacon_at: ``beacon_at(i)``, the beacon robot ``i`` can read now (the station of
             the vertex whose centre it stands on), else None; set by loop functions.
+        ranging: robots carry a radio-ranging sensor (as ultra-wideband radios do): the
+            range and bearing of every radio neighbour, fixed nodes included, noise-free,
+            as ``Observation.detections``.
     """
 
     def __init__(self, sim: Simulation, bearing: BearingSensor | None = None,
                  present: np.ndarray | None = None,
-                 beacon_at: Callable[[int], Any] | None = None) -> None:
+                 beacon_at: Callable[[int], Any] | None = None, ranging: bool = False) -> None:
         self.sim = sim
         self.n = sim.n
         self.present = np.ones(self.n, bool) if present is None else np.array(present, bool)
@@ -44,6 +48,8 @@ class SparkWorld(World):
         self.bearing = bearing
         self.beacon_at = beacon_at
         self.uplinks = {}
+        self.fixed = {}
+        self.ranging = ranging
         self._v = [0.0] * self.n  # commands of this tick, as floats (cheaper than numpy items)
         self._w = [0.0] * self.n
         self._version = -1
@@ -73,8 +79,20 @@ class SparkWorld(World):
         inbox, neighbors = self._inbox(i)
         return Observation(
             i, self._now_s, line[i], ir[i], encoder[i], wheel_speed[i], battery[i], None,
-            NOTHING if self._bearings is None else self._bearings[i], NOTHING, inbox,
+            NOTHING if self._bearings is None else self._bearings[i],
+            self._ranges(i, neighbors) if self.ranging else NOTHING, inbox,
             neighbors, None if self.beacon_at is None else self.beacon_at(i))
+
+    def _ranges(self, i: int, neighbors) -> dict:
+        """Robot ``i``'s ranging of its radio neighbours: range (m) and bearing (rad)."""
+        poses = self.sim.poses()
+        x, y, yaw = poses[i]
+        out = {}
+        for j in neighbors:
+            jx, jy = self.fixed[j] if j in self.fixed else poses[j, :2]
+            bearing = math.remainder(math.atan2(jy - y, jx - x) - yaw, 2 * math.pi)
+            out[j] = Detection(math.hypot(jx - x, jy - y), bearing)
+        return out
 
     def commanded_speeds(self) -> np.ndarray:
         return np.array(self._v)
