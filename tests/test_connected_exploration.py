@@ -199,6 +199,7 @@ def test_embodied_with_range_to_spare_changes_nothing():
     assert result.collisions == 0 and result.cut_ticks == 0 and result.connected_share == 1.0
 
 
+@pytest.mark.slow
 def test_embodied_too_short_a_range_ends_in_a_verdict():
     """1.5 m: walls cut links the leash cannot foresee; the robots back out of each cut
     (a few ticks), and the team declares itself infeasible instead of running on."""

@@ -1,7 +1,7 @@
 """The kinematic tier (issue 16): fidelity to the dynamic tier, the contact rule,
-determinism and bad input. The covering walk of fig9 and the main job in the kinematic
-tier are slow; the lap of arena1 and its two-robot exploration are their fast
-representatives."""
+determinism and bad input. The covering walk of fig9 and the shipped figures (arena1 with
+two robots, the main job) in both tiers are slow; the lap of arena1 is their fast
+representative."""
 
 from __future__ import annotations
 
@@ -71,6 +71,7 @@ def test_a_lap_of_arena1_agrees_with_the_dynamic_tier():
     agree("arena1", 1)
 
 
+@pytest.mark.slow
 def test_shipped_arena1_figures_are_equal_in_both_tiers():
     agree("arena1", 2)
 
@@ -142,7 +143,9 @@ def test_a_robot_driving_into_a_wall_stops_at_it():
     assert sim.collisions.events == []  # walls are no robot-robot contact
 
 
-@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("seed", [0, 1, 2, pytest.param(3, marks=pytest.mark.slow),
+                                  pytest.param(4, marks=pytest.mark.slow),
+                                  pytest.param(5, marks=pytest.mark.slow)])
 def test_no_move_ever_deepens_an_overlap_in_a_random_crowd(seed):
     """Property: 12 robots with random commands in a walled 1.2 m box for 6 s never
     overlap each other or a wall (they start apart)."""
