@@ -88,7 +88,6 @@ class RelayAccepted(NamedTuple):
     relay: Hashable
 
 
-FLOODED = (RelayWanted, RelayOffer, RelayAccepted)
 
 
 def flood_key(payload) -> tuple | None:
