@@ -150,7 +150,9 @@ def register(subparsers) -> None:
                              "messages and the share of time every robot had a route to "
                              "the base. Embodied world: walls block; the robots keep "
                              "connectivity tables (seed 004) while they move and the result "
-                             "reports how often their beliefs matched the truth")
+                             "reports how often their beliefs matched the truth; with "
+                             "--connectivity they keep their tether to a base on a 1 m mast "
+                             "at the root instead")
     parser.add_argument("--max-time", type=float, default=None, metavar="T",
                         help="give up after T: graph world time units (default: "
                              "50 (E + 1) + 100); embodied simulated seconds (default: 3600)")
