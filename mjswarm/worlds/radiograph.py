@@ -130,8 +130,8 @@ class RadioGraphWorld:
         last_tick = math.floor(max_time * TICKS_PER_UNIT)
         while declared is None and infeasible is None and ticks < last_tick:
             tick = ticks = ticks + 1
-            radio.step(xy)
-            if constrained:
+            if constrained:  # deliver; the links are those of the last tick's end
+                radio.step()
                 around = [self._around(radio, i, xy) for i in range(k)]
                 for i in order:
                     for m in robots[i].hear(tick, radio.receive(i), around[i]):
