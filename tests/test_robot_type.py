@@ -3,6 +3,7 @@ from sensors only, the radio's one tick of latency through the loop, and the hoo
 
 from __future__ import annotations
 
+import gc
 import math
 
 import numpy as np
@@ -124,3 +125,25 @@ def test_a_message_without_a_radio_is_an_error():
     world = PointWorld([(0.0, 0.0)])
     with pytest.raises(MjswarmError, match="no radio"):
         Loop(world, {0: Recorder(lambda t: "hi")}).step()
+
+
+def test_a_run_freezes_the_collector_while_it_runs_and_leaves_it_as_it_found_it():
+    seen = []
+
+    class Probe(LoopFunctions):
+        def after_step(self, loop):
+            seen.append(gc.get_freeze_count())
+            if loop.ticks == 3:
+                raise RuntimeError("a hook failed")
+
+    world = PointWorld([(0.0, 0.0)])
+    assert gc.get_freeze_count() == 0
+    with pytest.raises(RuntimeError, match="a hook failed"):
+        Loop(world, {0: Recorder()}, [Probe()]).run(max_ticks=5)
+    assert seen[0] > 0 and gc.get_freeze_count() == 0  # frozen in the run, thawed after
+    gc.freeze()  # a caller's own freeze is left alone
+    try:
+        Loop(world, {0: Recorder()}).run(max_ticks=2)
+        assert gc.get_freeze_count() > 0  # not thawed by the run
+    finally:
+        gc.unfreeze()

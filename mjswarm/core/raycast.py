@@ -232,7 +232,8 @@ def _cast(origin, direction, length, exclude_body, candidate, geom_type, geom_bo
                     g = cell_geoms[k]
                     if (not candidate[g] or max(static_corner[g, 0], cx0) != cx
                             or max(static_corner[g, 1], cy0) != cy
-                            or not _meets_box(static_box, g, pnt, vec, top)):
+                            or not _meets_box(static_box, g, pnt, vec,
+                                              top if best < 0 else min(top, best))):
                         continue
                     best, best_geom = _try(g, best, best_geom, pnt, vec, top, skip, candidate,
                                            geom_type, geom_bodyid, geom_xpos, geom_xmat,
@@ -245,7 +246,8 @@ def _cast(origin, direction, length, exclude_body, candidate, geom_type, geom_bo
                 for k in range(robot_start[c], robot_start[c + 1]):
                     i = robots[k]
                     centre = (centres[i, 0], centres[i, 1], centres[i, 2])
-                    if _gap_sq(centre, pnt, vec, top) > robot_radius * robot_radius * (1 + 1e-9):
+                    reach = top if best < 0 else min(top, best)  # no nearer hit beyond
+                    if _gap_sq(centre, pnt, vec, reach) > robot_radius * robot_radius * (1 + 1e-9):
                         continue
                     for j in range(robot_geom_start[i], robot_geom_start[i + 1]):
                         best, best_geom = _try(robot_geoms[j], best, best_geom, pnt, vec, top,
@@ -296,7 +298,8 @@ def _try(g, best, best_geom, pnt, vec, top, skip, candidate, geom_type, geom_bod
         return best, best_geom
     kind = geom_type[g]
     pos = (geom_xpos[g, 0], geom_xpos[g, 1], geom_xpos[g, 2])
-    if kind != PLANE and _gap_sq(pos, pnt, vec, top) > geom_rbound[g] * geom_rbound[g] * (1 + 1e-9):
+    reach = top if best < 0 else min(top, best)  # a hit beyond the best one cannot win
+    if kind != PLANE and _gap_sq(pos, pnt, vec, reach) > geom_rbound[g] * geom_rbound[g] * (1 + 1e-9):
         return best, best_geom
     mat = (geom_xmat[g, 0], geom_xmat[g, 1], geom_xmat[g, 2], geom_xmat[g, 3], geom_xmat[g, 4],
            geom_xmat[g, 5], geom_xmat[g, 6], geom_xmat[g, 7], geom_xmat[g, 8])

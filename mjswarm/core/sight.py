@@ -3,10 +3,12 @@
 Robot ``k`` sees robot ``p`` when a ray from ``k``'s centre at ``RAY_HEIGHT_M``, towards
 ``p``'s centre, hits ``p`` first; only collision geoms (``COLLISION_GROUP``: robots, walls, the floor) block.
 The bearing sensor (:mod:`mjswarm.core.bearing`) asks this for the ordered pairs in its field of
-view, the radio (:func:`mjswarm.experiments.awareness.sight_blocker`) for both directions of every
-pair in range. :class:`LineOfSight` answers each ordered pair once per world state (the
-simulation's ``state_version``), so the bearing sensor's rays, a subset of the radio's
-when both have the same range, cost nothing in a tick where the radio has already asked.
+view, the radio (:func:`mjswarm.experiments.awareness.sight_blocker`) for every pair in range
+one way, and the way back only where the way there is clear (a link needs both).
+:class:`LineOfSight` answers each ordered pair once per world state (the simulation's
+``state_version``), so the bearing sensor's rays that the radio has already cast in a tick
+(all of them between robots that see each other, when both have the same range) cost
+nothing.
 The rays are cast by the simulation's :class:`~mjswarm.core.raycast.RayCaster`, which answers as
 ``mj_ray`` does (``tests/test_raycast.py`` checks every ordered pair against ``mj_ray``).
 """

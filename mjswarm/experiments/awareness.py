@@ -43,8 +43,9 @@ def sight_blocker(sim: Simulation, fixed: Mapping[Hashable, tuple[float, float]]
 
     def between_robots(pairs: np.ndarray) -> np.ndarray:
         i, j = np.asarray(pairs, np.int64).reshape(-1, 2).T
-        seen = sim.sight(np.concatenate([i, j]), np.concatenate([j, i]))
-        return ~(seen[: len(i)] & seen[len(i):])
+        seen = sim.sight(i, j)  # the way back only where the way there is clear
+        seen[seen] = sim.sight(j[seen], i[seen])
+        return ~seen
 
     if not fixed:
         return between_robots

@@ -26,6 +26,7 @@ in the next tick's observations: the radio's one tick of latency (seed 002 Assum
 
 from __future__ import annotations
 
+import gc
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
@@ -244,12 +245,25 @@ class Loop:
     def run(self, max_ticks: int | None = None,
             on_tick: Callable[[Loop], None] | None = None) -> list[Any]:
         """Step until a loop function stops the run (or ``max_ticks``); the results of
-        every loop function, in order. A later call runs on from where it stopped."""
+        every loop function, in order. A later call runs on from where it stopped.
+
+        While it runs, the objects that existed when it started (the world, its model,
+        the controllers: some 10^5 of them with hundreds of robots) are frozen out of
+        Python's cyclic garbage collector (:func:`gc.freeze`), and thawed at the end:
+        otherwise each full collection rescans all of them, which cost 0.6 ms per tick at
+        300 robots (``mjswarm bench``). Nothing is frozen when the caller froze already."""
         self._stop = False
-        while not self._stop and (max_ticks is None or self.ticks < max_ticks):
-            self.step()
-            if on_tick is not None:
-                on_tick(self)
+        freeze = gc.get_freeze_count() == 0
+        if freeze:
+            gc.freeze()
+        try:
+            while not self._stop and (max_ticks is None or self.ticks < max_ticks):
+                self.step()
+                if on_tick is not None:
+                    on_tick(self)
+        finally:
+            if freeze:
+                gc.unfreeze()
         return [f.result(self) for f in self.functions]
 
     @property
