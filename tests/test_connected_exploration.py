@@ -9,6 +9,7 @@ import pytest
 
 from algorithms.exploration.tether import (BASE, STALL_TIME_UNITS, STALL_UNITS_PER_EDGE,
                                            Adopt, Adopted, Beat, Tether)
+from algorithms.exploration.relay import RELAY, RETURN, ConnectedExplorer
 from algorithms.robot import Message
 from mjswarm.arena import load_arena
 from mjswarm.cli import main
@@ -92,6 +93,27 @@ def test_relays_carry_the_team_down_a_path_longer_than_the_range(robots, complet
     assert result.cut_ticks == 0
     if completes:
         assert result.map_correct and result.relay_trips > 0
+
+
+def test_a_corridor_chain_is_not_anchored_next_to_the_base():
+    """A 4.2 m corridor (lattice:1x8), five robots at 1 m: only robots standing by their
+    own choice adopt, so no relay is made next to the base and the chain reaches 6 of the
+    7 edges (5 when a robot paused near the root could be adopted)."""
+    result, _ = run("lattice:1x8", 5, 1.0)
+    assert result.infeasible and result.cut_ticks == 0
+    assert "explored 6 of 7 edges" in result.reason
+
+
+def test_a_robot_paused_between_moves_does_not_say_it_stands_still():
+    """The beat's ``still`` (whom rule 4 may ask) is for robots settled by choice."""
+    robot = ConnectedExplorer(0, make_minds("incidence-dfs", 1, None)[0], Tether(0, range_m=1.0))
+    beats = lambda out: [m.payload for m in out if isinstance(m.payload, Beat)]
+    robot.mode = RETURN  # on its way back to its task, not moving this tick
+    assert not beats(robot.after(1, None, False, {}))[0].still
+    robot.mode = RELAY
+    assert beats(robot.after(2, None, False, {}))[0].still
+    robot.mode = RETURN
+    assert beats(robot.after(3, (0.1, 0.0), False, {}))[0].still  # stuck at its leash
 
 
 # ---------------------------------------------------------------------------- the tether

@@ -28,6 +28,13 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   request for ``RESUME_AFTER_TICKS``. A robot walking back to its task that gets stuck is
   free to serve, and retreats again after as long.
 
+* **Settled robots adopt.** A robot's beat says it stands still only when it stands by
+  its own choice: a relay, in reserve, idle, holding, or stuck at the end of its leash.
+  Rule 4 asks only robots whose beat says so, so a robot that merely paused between two
+  moves (at a vertex on its way back to its task, say) is never made a permanent anchor
+  wherever it happened to be (on ``lattice:1x8`` with five robots at 1 m, a robot
+  adopted next to the base held there for the rest of the run).
+
 The walk is the robot's own: it follows incidence angles from vertex to vertex as seed
 003's robots do; routes name vertices by their beacons (each beacon's hardware identity).
 Flooded messages are forwarded once by every robot and by the base.
@@ -331,9 +338,18 @@ class ConnectedExplorer:
             self.stop_at, self.stuck = None, 0
         if self.mode == RESERVE and tick - self.last_wanted >= RESUME_AFTER_TICKS:
             self.plan, self.mode = self._way(*self.task), RETURN
-        out.append(self.tether.beat(tick, moved, self.progressed, len(self.mind.map_edges())))
+        out.append(self.tether.beat(tick, moved or not self._settled(), self.progressed,
+                                    len(self.mind.map_edges())))
         self.progressed = False
         return out
+
+    def _settled(self) -> bool:
+        """Whether it stands by its own choice (a relay, in reserve, idle, holding, or stuck
+        at the end of its leash): only then does its beat say it is still, so that nobody
+        asks a robot that merely paused between two moves to adopt them (it would hold
+        there for as long as its child needs it)."""
+        return (self.mode in (RELAY, RESERVE) or self.idle or self.stuck > 0
+                or bool(self.tether.children))
 
     def _relay_tick(self, tick: int) -> None:
         if self.tether.children:
