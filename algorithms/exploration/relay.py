@@ -95,8 +95,6 @@ class RelayAccepted(NamedTuple):
     relay: Hashable
 
 
-
-
 def flood_key(payload) -> tuple | None:
     """What identifies a flooded message (None: not flooded)."""
     if isinstance(payload, RelayWanted):

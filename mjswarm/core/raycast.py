@@ -232,8 +232,7 @@ def _cast(origin, direction, length, exclude_body, candidate, geom_type, geom_bo
                     g = cell_geoms[k]
                     if (not candidate[g] or max(static_corner[g, 0], cx0) != cx
                             or max(static_corner[g, 1], cy0) != cy
-                            or not _meets_box(static_box, g, pnt, vec,
-                                              top if best < 0 else min(top, best))):
+                            or not _meets_box(static_box, g, pnt, vec, _reach(top, best))):
                         continue
                     best, best_geom = _try(g, best, best_geom, pnt, vec, top, skip, candidate,
                                            geom_type, geom_bodyid, geom_xpos, geom_xmat,
@@ -246,8 +245,7 @@ def _cast(origin, direction, length, exclude_body, candidate, geom_type, geom_bo
                 for k in range(robot_start[c], robot_start[c + 1]):
                     i = robots[k]
                     centre = (centres[i, 0], centres[i, 1], centres[i, 2])
-                    reach = top if best < 0 else min(top, best)  # no nearer hit beyond
-                    if _gap_sq(centre, pnt, vec, reach) > robot_radius * robot_radius * (1 + 1e-9):
+                    if _gap_sq(centre, pnt, vec, _reach(top, best)) > robot_radius * robot_radius * (1 + 1e-9):
                         continue
                     for j in range(robot_geom_start[i], robot_geom_start[i + 1]):
                         best, best_geom = _try(robot_geoms[j], best, best_geom, pnt, vec, top,
@@ -271,6 +269,13 @@ def _gap_sq(point, pnt, vec, top):  # pragma: no cover (compiled)
     t = min(max(t, 0.0), top)
     g0, g1, g2 = d0 - t * vec[0], d1 - t * vec[1], d2 - t * vec[2]
     return g0 * g0 + g1 * g1 + g2 * g2
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _reach(top, best):  # pragma: no cover (compiled)
+    """How far along the ray a hit can still win: its length, or the best hit so far (a
+    geom whose bounding sphere lies beyond it can neither beat nor tie it)."""
+    return top if best < 0 else min(top, best)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -298,8 +303,7 @@ def _try(g, best, best_geom, pnt, vec, top, skip, candidate, geom_type, geom_bod
         return best, best_geom
     kind = geom_type[g]
     pos = (geom_xpos[g, 0], geom_xpos[g, 1], geom_xpos[g, 2])
-    reach = top if best < 0 else min(top, best)  # a hit beyond the best one cannot win
-    if kind != PLANE and _gap_sq(pos, pnt, vec, reach) > geom_rbound[g] * geom_rbound[g] * (1 + 1e-9):
+    if kind != PLANE and _gap_sq(pos, pnt, vec, _reach(top, best)) > geom_rbound[g] * geom_rbound[g] * (1 + 1e-9):
         return best, best_geom
     mat = (geom_xmat[g, 0], geom_xmat[g, 1], geom_xmat[g, 2], geom_xmat[g, 3], geom_xmat[g, 4],
            geom_xmat[g, 5], geom_xmat[g, 6], geom_xmat[g, 7], geom_xmat[g, 8])

@@ -89,7 +89,7 @@ from mjswarm.core.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.faults import Fault
 from mjswarm.worlds.graphworld import ExplorationResult, make_minds, outcome
-from mjswarm.worlds.radiograph import CONNECTIVITY, NEED
+from mjswarm.worlds.radiograph import CONNECTIVITY, NEED, infeasible_reason
 from mjswarm.outputs.recording import contact_event
 from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.navigation import calibration, conventions
@@ -653,10 +653,8 @@ class EmbodiedExploration(LoopFunctions):
                       margin_m=TETHER_MARGIN_M, ticks_per_unit=ticks)
 
     def _infeasible_reason(self) -> str:
-        explored = {tuple(sorted(e)) for p in self.paths for e in zip(p, p[1:])}
-        return (f"infeasible with {len(self.robots)} robots at range "
-                f"{self.config.radio_range_m:g} m: explored {len(explored)} of "
-                f"{len(self.spec.edges)} edges")
+        return infeasible_reason(len(self.robots), self.config.radio_range_m, self.paths,
+                                 len(self.spec.edges))
 
     def _event(self, i: int | None, text: str) -> None:
         if self.recorder is not None:

@@ -54,6 +54,14 @@ NEED = {"connected": 1, "biconnected": 2}
 TICKS_PER_UNIT = 10
 
 
+def infeasible_reason(robots: int, range_m: float, paths: list[list], edges: int) -> str:
+    """The verdict of a team that declared a stall (rule 5 of the tether), with the share
+    of the ``edges`` true edges its ``paths`` (vertex sequences, one per robot) covered."""
+    explored = {tuple(sorted(e)) for p in paths for e in zip(p, p[1:])}
+    return (f"infeasible with {robots} robots at range {range_m:g} m: explored "
+            f"{len(explored)} of {edges} edges")
+
+
 @dataclass
 class ConnectedExplorationResult(ExplorationResult):
     """An exploration under a connectivity constraint (times in time units).
@@ -167,10 +175,7 @@ class RadioGraphWorld:
                 if sense == 0:
                     continue
                 v, u = edge[i]
-                share = min(1.0 / (w.duration[(v, u)] * TICKS_PER_UNIT),
-                            1.0 - progress[i] if sense > 0 else progress[i])
-                d = sense * share * (self.pos[u] - self.pos[v])
-                step = (float(d[0]), float(d[1]))
+                share, step = self._step(edge[i], progress[i], sense)
                 if constrained and not robots[i].tether.may_step(step, around[i]):
                     wanted[i] = step
                     continue
@@ -197,11 +202,8 @@ class RadioGraphWorld:
         completed_at = None if declared is None else declared[0]
         fields = outcome(minds, declared, completed_at, paths, beacon_vertex, w.edges,
                          arena=arena, root=w.root, edge_time=w.edge_time, seed=seed)
-        reason = None
-        if infeasible is not None:
-            explored = {tuple(sorted(e)) for p in paths for e in zip(p, p[1:])}
-            reason = (f"infeasible with {k} robots at range {self.range_m:g} m: explored "
-                      f"{len(explored)} of {len(w.edges)} edges")
+        reason = None if infeasible is None else infeasible_reason(k, self.range_m, paths,
+                                                                   len(w.edges))
         return ConnectedExplorationResult(
             **fields, connectivity=self.connectivity, radio_range_m=self.range_m,
             messages=radio.total_sent, connected_share=1.0 - cut / max(ticks, 1),
@@ -209,12 +211,15 @@ class RadioGraphWorld:
             fragile_ticks=fragile, relay_trips=sum(r.relay_trips for r in robots),
             infeasible=infeasible is not None, reason=reason)
 
-    def _step(self, e: tuple[str, str], progress: float) -> tuple[float, float]:
-        """The displacement (m) a robot on edge ``e`` makes in one tick."""
+    def _step(self, e: tuple[str, str], progress: float,
+              sense: int) -> tuple[float, tuple[float, float]]:
+        """One tick's walk on edge ``e`` (``progress`` of it behind the robot) on along it
+        (``sense`` +1) or back (-1): the share of the edge covered, and the displacement (m)."""
         v, u = e
-        share = min(1.0 / (self.world.duration[e] * TICKS_PER_UNIT), 1.0 - progress)
-        d = share * (self.pos[u] - self.pos[v])
-        return float(d[0]), float(d[1])
+        share = min(1.0 / (self.world.duration[e] * TICKS_PER_UNIT),
+                    1.0 - progress if sense > 0 else progress)
+        d = sense * share * (self.pos[u] - self.pos[v])
+        return share, (float(d[0]), float(d[1]))
 
     def _around(self, radio: Radio, i: int, xy: np.ndarray) -> dict:
         """Robot ``i``'s range-and-bearing sensing of its radio neighbours (m, relative)."""
