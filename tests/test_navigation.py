@@ -112,3 +112,38 @@ def test_measured_angles_are_in_the_robots_own_frame():
     truth = [incidence_angle(spec, "v1", w) + math.pi / 2 for w in ("v2", "v3")]
     errors = [min(angle_error_deg(m, t) for m in nav.edge_angles) for t in truth]
     assert np.max(errors) < 3.0
+
+
+@pytest.mark.parametrize("drive_m", [0.05, 0.3, 0.7, 1.2])
+def test_a_robot_turned_back_part_way_arrives_where_it_left_by_the_edge_it_left_along(drive_m):
+    """Rule 6's walks back (:meth:`Navigator.turn_back`): turned back while leaving (5 cm),
+    short of its corridor (0.3 m) or on its lane (0.7 m, and 1.2 m, past the wall's end at
+    the far vertex of a 1.5 m edge), the robot is back on the centre it left, measures the
+    same edges, and reports the edge it left along as the one it came by."""
+    spec = load_arena("lattice:2x2:1.5")
+    x, y = spec.vertices[spec.root]
+    sim = Simulation(arena_world_spec(spec, [Pose2D(x, y, 0.0)]))
+    nav = Navigator(calibration(sim.geometry), conventions(sim.geometry), 0.0, SPEED_M_S)
+    driver = Loop(SparkWorld(sim), {0: Navigating(nav)})
+    nav.begin_at_vertex()
+    while nav.state is not NavigatorState.AT_VERTEX:
+        driver.step()
+    first = list(nav.edge_angles)
+    assert len(first) == 2
+    nav.depart(first[0])
+    start = nav.odometry.distance_m
+    while nav.odometry.distance_m - start < drive_m:
+        driver.step()
+        assert nav.state in (NavigatorState.LEAVING, NavigatorState.ON_EDGE), nav.events[-1]
+    assert nav.turn_back()
+    for _ in range(MAX_TICKS_PER_LEG):
+        if nav.state is NavigatorState.AT_VERTEX:
+            break
+        assert nav.state is not NavigatorState.LOST, nav.events[-1]
+        driver.step()
+    else:
+        raise AssertionError(f"not back at the vertex; events {nav.events[-3:]}")
+    assert math.dist(sim.poses()[0][:2], (x, y)) < ARRIVAL_TOLERANCE_M
+    assert angle_error_deg(nav.arrived_angle, first[0]) < ANGLE_TOLERANCE_DEG
+    assert len(nav.edge_angles) == len(first)
+    assert max(min(angle_error_deg(a, b) for a in nav.edge_angles) for b in first) < ANGLE_TOLERANCE_DEG

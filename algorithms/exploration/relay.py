@@ -4,7 +4,7 @@ The tether keeps every robot connected, but a robot that reaches the end of its 
 only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
 
 * **Request.** An exploring robot (or one walking back to its task) that has wanted to
-  step and could not for ``RECRUIT_AFTER_TICKS`` floods ``RelayWanted`` with where it is: its loop-free route
+  step and could not for ``RECRUIT_AFTER_UNITS`` floods ``RelayWanted`` with where it is: its loop-free route
   from the root (the legs it took, each named by the beacon it started from and the
   incidence angles at both ends), the leg it is on, and how far along it is.
 * **Offer.** A robot that is free (exploring, without children, and itself stuck as long,
@@ -12,21 +12,25 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   to requesters with a smaller index, and then drops its request, so one of two stuck
   robots always serves the other.
 * **Accept.** The requester takes the first offer (the lowest index among those of one
-  tick) and floods ``RelayAccepted``; other offers lapse after ``OFFER_TIMEOUT_TICKS``.
+  tick) and floods ``RelayAccepted``; other offers lapse after ``OFFER_TIMEOUT_UNITS``.
 * **Transit.** The relay suspends its own task (its strategy is not asked anything and no
   beacon is written until it resumes), goes back to the last vertex where its route and the
   requester's agree, then along the requester's route and leg, and stops where the
   requester is (or where its own leash stops it). There it stands still: rule 4 lets the
   requester adopt it, and the requester goes on within range of its relay.
 * **Release.** A relay holds while it has children. Once it has had none for
-  ``RELEASE_TICKS`` (its child went on, or came back and re-attached nearer the base), or
-  was never adopted within ``RELAY_PATIENCE_TICKS``, it goes back the same way and resumes
+  ``RELEASE_UNITS`` (its child went on, or came back and re-attached nearer the base), or
+  was never adopted within ``RELAY_PATIENCE_UNITS``, it goes back the same way and resumes
   its own task where it left it.
-* **Retreat.** An exploring robot stuck without children for ``RETREAT_AFTER_TICKS``
+* **Retreat.** An exploring robot stuck without children for ``RETREAT_AFTER_UNITS``
   (nobody came) suspends its task and walks back to the root, where it waits in
   reserve: free to serve as a relay, and back to its own task once it has heard no
-  request for ``RESUME_AFTER_TICKS``. A robot walking back to its task that gets stuck is
+  request for ``RESUME_AFTER_UNITS``. A robot walking back to its task that gets stuck is
   free to serve, and retreats again after as long.
+
+* **Held on the way.** A relay that the world holds on its way (a body ahead on its lane,
+  a vertex area it may not enter yet) for as long as it waits at a leash stops where it
+  is and relays from there, as one the leash stops.
 
 * **Settled robots adopt.** A robot's beat says it stands still only when it stands by
   its own choice: a relay, in reserve, idle, holding, or stuck at the end of its leash.
@@ -37,6 +41,10 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
 
 The walk is the robot's own: it follows incidence angles from vertex to vertex as seed
 003's robots do; routes name vertices by their beacons (each beacon's hardware identity).
+Walking back along an edge is the world's: the graph world reverses, a MuJoCo robot turns
+onto the opposite lane (:meth:`~algorithms.navigation.Navigator.turn_back`); a robot that
+can only go on (it is arriving at the vertex ahead) walks back from there along the edge
+it came by. The waits are in time units, so they keep their meaning at any control rate.
 Flooded messages are forwarded once by every robot and by the base.
 """
 
@@ -49,18 +57,19 @@ from algorithms.exploration.base import IDLE, Decision, Strategy, go
 from algorithms.exploration.tether import Tether
 from algorithms.robot import Message
 
-#: Ticks a robot waits at the end of its leash before it asks for a relay.
-RECRUIT_AFTER_TICKS = 10
-#: Ticks an offer (or a request without offers) stays open.
-OFFER_TIMEOUT_TICKS = 40
-#: Ticks a relay stays without children before it goes back.
-RELEASE_TICKS = 10
-#: Ticks a relay waits to be adopted before it goes back.
-RELAY_PATIENCE_TICKS = 40
-#: Ticks an exploring robot stays stuck before it retreats to the root.
-RETREAT_AFTER_TICKS = RECRUIT_AFTER_TICKS + OFFER_TIMEOUT_TICKS
-#: Ticks without a request after which a robot in reserve resumes its task.
-RESUME_AFTER_TICKS = 50
+#: Rule 6's waits, in time units (an edge's traversal: the tether's ``ticks_per_unit``
+#: control ticks). How long a robot waits at the end of its leash before it asks for a relay:
+RECRUIT_AFTER_UNITS = 1.0
+#: How long an offer (or a request without offers) stays open.
+OFFER_TIMEOUT_UNITS = 4.0
+#: How long a relay stays without children before it goes back.
+RELEASE_UNITS = 1.0
+#: How long a relay waits to be adopted before it goes back.
+RELAY_PATIENCE_UNITS = 4.0
+#: How long an exploring robot stays stuck before it retreats to the root.
+RETREAT_AFTER_UNITS = RECRUIT_AFTER_UNITS + OFFER_TIMEOUT_UNITS
+#: How long a robot in reserve hears no request before it resumes its task.
+RESUME_AFTER_UNITS = 5.0
 
 EXPLORE, TRANSIT, RELAY, RETURN, RETREAT, RESERVE = (
     "explore", "transit", "relay", "return", "retreat", "reserve")
@@ -120,13 +129,32 @@ class Flooder:
         return True
 
 
+class Waits(NamedTuple):
+    """Rule 6's waits in control ticks (the ``*_UNITS`` constants at a world's rate)."""
+
+    recruit: int
+    offer: int
+    release: int
+    patience: int
+    retreat: int
+    resume: int
+
+    @classmethod
+    def at(cls, ticks_per_unit: int) -> "Waits":
+        units = (RECRUIT_AFTER_UNITS, OFFER_TIMEOUT_UNITS, RELEASE_UNITS, RELAY_PATIENCE_UNITS,
+                 RETREAT_AFTER_UNITS, RESUME_AFTER_UNITS)
+        return cls(*(max(1, round(u * ticks_per_unit)) for u in units))
+
+
 class ConnectedExplorer:
     """A seed-003 strategy on a tether, with relays on demand (module docstring).
 
     The world calls, each tick: :meth:`hear`; at a vertex :meth:`arrive` (all robots of a
     batch first) and :meth:`on_vertex`; on an edge :meth:`direction` and, for the step,
-    ``tether.may_step``; then :meth:`after`. ``progress`` (the share of its edge behind it)
-    is the robot's odometry.
+    ``tether.may_step``; then :meth:`after`. ``progress`` (how far along its leg it is) is
+    the robot's odometry, in the world's measure: the share of the edge in the graph
+    world, metres driven since it left the vertex on the MuJoCo robots (a robot compares
+    only its own progress with a requester's, on the same leg).
     """
 
     def __init__(self, index: int, mind: Strategy, tether: Tether) -> None:
@@ -140,7 +168,11 @@ class ConnectedExplorer:
         self.backwards = False
         self.progress = 0.0
         self.idle = False
-        self.stuck = 0  # ticks it wanted to step and could not
+        self.stuck = 0  # ticks it wanted to step and the leash forbade it
+        self.held = 0  # ticks it wanted to move and the world held it
+        self._waits = Waits.at(tether.ticks_per_unit)
+        #: whether its last vertex call asked its strategy (else: it walked a plan)
+        self.consulted = False
         self.serial = 0
         self.request: tuple[int, int] | None = None  # (serial, tick) of an open request
         self.offer: tuple[Hashable, int, int] | None = None  # (requester, serial, tick)
@@ -186,7 +218,7 @@ class ConnectedExplorer:
     def _free(self) -> bool:
         if self.tether.children or self.offer is not None or self.tether.request is not None:
             return False
-        stuck = self.stuck >= RECRUIT_AFTER_TICKS
+        stuck = self.stuck >= self._waits.recruit
         return (self.mode == RESERVE or (self.mode == EXPLORE and (stuck or self.idle))
                 or (self.mode == RETURN and stuck))
 
@@ -218,12 +250,16 @@ class ConnectedExplorer:
 
     # ------------------------------------------------------------------ at a vertex
     def arrive(self, beacon, angles: Sequence[float], arrived_by: float | None) -> None:
+        if self.plan and self.plan[0] == ("back",):
+            # the world could not turn it back where it was (a body arriving at a vertex
+            # goes on to its centre): it walks back along the edge it came by
+            self.plan[0] = ("go", arrived_by)
         self._walked_to(beacon, arrived_by)
         if self.mode == EXPLORE:
             self.mind.arrive(beacon, angles, arrived_by)
 
     def on_vertex(self, beacon, angles: Sequence[float], arrived_by: float | None) -> Decision:
-        self.idle = False
+        self.idle = self.consulted = False
         if self.mode in (TRANSIT, RETURN, RETREAT) and not self.plan:
             if self.mode == TRANSIT:  # the requester stood at a vertex
                 return self._become_relay_here()
@@ -240,6 +276,7 @@ class ConnectedExplorer:
                 self.stop_at = step[2]
             return self._depart(beacon, step[1])
         self.progressed = arrived_by is not None
+        self.consulted = True
         decision = self.mind.on_vertex(beacon, angles, arrived_by)
         if decision.action == "go":
             return self._depart(beacon, decision.angle)
@@ -269,6 +306,12 @@ class ConnectedExplorer:
             self.route.append(done)
 
     # ------------------------------------------------------------------ on an edge
+    @property
+    def stops_part_way(self) -> bool:
+        """Whether the leg it is setting out on ends part-way, where its requester is (a
+        relay's last leg): it needs the lane, not the vertex at the far end."""
+        return self.mode == TRANSIT and self.stop_at is not None
+
     def direction(self, progress: float) -> int:
         """+1 on along the edge, -1 back, 0 stay."""
         self.progress = progress
@@ -309,32 +352,35 @@ class ConnectedExplorer:
 
     # ------------------------------------------------------------------ end of tick
     def after(self, tick: int, wanted: Sequence[float] | None, moved: bool,
-              around: Mapping) -> list[Message]:
-        """``wanted``: the step it wanted and did not take (None if none)."""
+              around: Mapping, held: bool = False) -> list[Message]:
+        """``wanted``: the step the leash forbade it (None if none); ``held``: it wanted to
+        move and the world held it (a body ahead on its lane, a vertex not yet entered)."""
         self._tick = tick
+        waits = self._waits
         out = self.tether.ask(tick, wanted, around)
         blocked = wanted is not None and not self.tether.children
         self.stuck = self.stuck + 1 if blocked else 0
-        if self.mode in (EXPLORE, RETURN) and self.stuck >= RECRUIT_AFTER_TICKS and self.leg is not None:
-            if self.request is None or tick - self.request[1] > OFFER_TIMEOUT_TICKS:
+        self.held = self.held + 1 if held else 0
+        if self.mode in (EXPLORE, RETURN) and self.stuck >= waits.recruit and self.leg is not None:
+            if self.request is None or tick - self.request[1] > waits.offer:
                 self.serial += 1
                 self.request = (self.serial, tick)
                 w = RelayWanted(self.index, self.serial, tuple(self.route), self.leg,
                                 self.progress)
                 self.flood.fresh(w)
                 out.append(Message(w))
-        if self.offer is not None and tick - self.offer[2] > OFFER_TIMEOUT_TICKS:
+        if self.offer is not None and tick - self.offer[2] > waits.offer:
             self.offer = None
-        if self.mode == TRANSIT and self.stuck >= RECRUIT_AFTER_TICKS:
+        if self.mode == TRANSIT and max(self.stuck, self.held) >= waits.recruit:
             self._become_relay_here()
         if self.mode == RELAY:
             self._relay_tick(tick)
-        if self.mode in (EXPLORE, RETURN) and self.stuck >= RETREAT_AFTER_TICKS:
+        if self.mode in (EXPLORE, RETURN) and self.stuck >= waits.retreat:
             if self.task is None:
                 self.task = (tuple(self.route), self.leg, self.progress)
             self.plan, self.mode, self.request = self._way([], None, 0.0), RETREAT, None
             self.stop_at, self.stuck = None, 0
-        if self.mode == RESERVE and tick - self.last_wanted >= RESUME_AFTER_TICKS:
+        if self.mode == RESERVE and tick - self.last_wanted >= waits.resume:
             self.plan, self.mode = self._way(*self.task), RETURN
         out.append(self.tether.beat(tick, moved or not self._settled(), self.progressed,
                                     len(self.mind.map_edges())))
@@ -354,9 +400,9 @@ class ConnectedExplorer:
             self.had_child_at = tick
             return
         if self.had_child_at is None:
-            if tick - self.relay_since < RELAY_PATIENCE_TICKS:
+            if tick - self.relay_since < self._waits.patience:
                 return
-        elif tick - self.had_child_at < RELEASE_TICKS:
+        elif tick - self.had_child_at < self._waits.release:
             return
         self.plan, self.mode = self._way(*self.task), RETURN
 

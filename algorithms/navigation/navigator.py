@@ -139,6 +139,7 @@ class Navigator:
         self._scans = 0
         self._tracks: list[float] = []  # effective track estimates, one per scan (m)
         self._lane: FollowLine | None = None
+        self._left: tuple[float, float, float] | None = None  # centre x, y and angle it left by
         self._wall_run_start: float | None = None
         self._wall_seen = False
         self.vertex_detected = False
@@ -156,8 +157,49 @@ class Navigator:
             *self._shift(angle, +1),
             (SeekLine(angle, self.speed, self.conv.max_seek_m), self._found_lane),
         ])
+        self._left = (self.odometry.x, self.odometry.y, angle)
         self.state = NavigatorState.LEAVING
         self.events.append(NavigatorEvent(NavEvent.LEFT_VERTEX))
+
+    def turn_back(self) -> bool:
+        """Head back to the vertex it left; False while it arrives at the vertex ahead
+        (it goes on to that centre: the caller turns it back from there).
+
+        In its corridor: a U-turn onto the opposite lane (face back, sidestep two lane
+        offsets to the left, find the lane), then on as along any edge: the vertex is
+        where the new left wall ends, and the arrival is by the edge it left along. Short
+        of its corridor (leaving, or on the lane before its wall): by odometry to the outer
+        end of the spoke it left by, then in along the spoke to the centre and a scan, as
+        on any arrival, by the edge it left along. Both
+        are ours (seed 003's robots never turned back)."""
+        if self.state is NavigatorState.ARRIVING:
+            return False
+        if self.state not in (NavigatorState.LEAVING, NavigatorState.ON_EDGE):
+            raise RuntimeError(f"turn_back() needs the robot on an edge, it is {self.state.value}")
+        x, y, angle = self._left
+        self._incoming = angle
+        if self.in_corridor:
+            back = wrap(self._lane.direction(self.odometry.theta) + math.pi)
+            self._plan = deque([
+                (Turn(back, self.turn_rate), None),
+                *self._shift(back, +1, 2.0 * self.conv.lane_offset_m),
+                (SeekLine(back, self.speed, self.conv.max_seek_m), self._found_lane),
+            ])
+            self.state = NavigatorState.LEAVING
+            return True
+        # to the outer end of the spoke it left by, then in along it as on any arrival
+        odo, out = self.odometry, self.conv.spoke_radius_m + self.cal.line_ahead_m
+        px, py = x + out * math.cos(angle), y + out * math.sin(angle)
+        toward, inward = math.atan2(py - odo.y, px - odo.x), wrap(angle + math.pi)
+        self._plan = deque([
+            (Turn(toward, self.turn_rate), None),
+            (Drive(math.hypot(px - odo.x, py - odo.y), toward, self._approach_speed), None),
+            (Turn(inward, self.turn_rate), None),
+            (SeekLine(inward, self._approach_speed, self.conv.max_seek_m), self._found_spoke),
+            (FollowSpoke(self._approach_speed), self._spoke_ended),
+        ])
+        self.state = NavigatorState.ARRIVING
+        return True
 
     def update(self, percept: Percept) -> tuple[float, float]:
         """Advance one control tick; return the ``(v, omega)`` command (m/s, rad/s)."""
@@ -205,12 +247,14 @@ class Navigator:
                 or self.state is NavigatorState.ARRIVING)
 
     # ---------------------------------------------------------------- plans
-    def _shift(self, heading: float, side: int) -> list:
-        """Sidestep ``lane_offset_m`` to the left (side=+1) or right (-1) of ``heading``."""
+    def _shift(self, heading: float, side: int, distance_m: float | None = None) -> list:
+        """Sidestep ``distance_m`` (default ``lane_offset_m``) to the left (side=+1) or
+        right (-1) of ``heading``."""
         diagonal = heading + side * SHIFT_ANGLE
+        across = self.conv.lane_offset_m if distance_m is None else distance_m
         return [
             (Turn(diagonal, self.turn_rate), None),
-            (Drive(self.conv.lane_offset_m / math.sin(SHIFT_ANGLE), diagonal, self.speed), None),
+            (Drive(across / math.sin(SHIFT_ANGLE), diagonal, self.speed), None),
             (Turn(heading, self.turn_rate), None),
         ]
 
