@@ -9,7 +9,8 @@ import pytest
 
 from algorithms.exploration.tether import (BASE, STALL_TIME_UNITS, STALL_UNITS_PER_EDGE,
                                            Adopt, Adopted, Beat, Tether)
-from algorithms.exploration.relay import RELAY, RETURN, ConnectedExplorer
+from algorithms.exploration.relay import (RELAY, RETURN, TRANSIT, ConnectedExplorer,
+                                          RelayOffer, RelayWanted, Waits)
 from algorithms.robot import Message
 from mjswarm.arena import load_arena
 from mjswarm.cli import main
@@ -116,7 +117,77 @@ def test_a_robot_paused_between_moves_does_not_say_it_stands_still():
     assert beats(robot.after(3, (0.1, 0.0), False, {}))[0].still  # stuck at its leash
 
 
+def test_rule_6_waits_keep_their_meaning_at_any_control_rate():
+    """The waits are time units: the graph world's 10 ticks per unit gives the same ticks
+    as before they were units, and a MuJoCo run's rate scales them."""
+    assert Waits.at(10) == Waits(10, 40, 10, 40, 50, 50)
+    assert Waits.at(500) == Waits(500, 2000, 500, 2000, 2500, 2500)
+
+
+def _wanted(requester=1):
+    from algorithms.exploration.relay import Leg
+
+    return Message(RelayWanted(requester, 1, (), Leg("b0", 0.0), 0.3), sender=requester)
+
+
+def test_a_robot_held_by_the_world_as_long_as_a_stuck_one_offers_itself():
+    """Rule 6 for bodies: a robot that vertex entry holds on a centre is free to relay, as
+    one stuck at its leash is; one held for a moment is not; one retired never is."""
+    robot = ConnectedExplorer(0, make_minds("incidence-dfs", 1, None)[0], Tether(0, range_m=1.0))
+    waits = robot._waits
+    for tick in range(1, waits.recruit):
+        robot.after(tick, None, False, {}, held=True)
+    offers = lambda out: [m.payload for m in out if isinstance(m.payload, RelayOffer)]
+    assert offers(robot.hear(waits.recruit, [_wanted(1)], {})) == []
+    robot.after(waits.recruit, None, False, {}, held=True)
+    assert offers(robot.hear(waits.recruit + 1, [_wanted(2)], {})) == [RelayOffer(2, 1, 0)]
+    robot.retire()
+    robot.offer = None
+    assert offers(robot.hear(waits.recruit + 2, [_wanted(3)], {})) == []
+
+
+def test_a_relay_held_on_its_way_relays_from_there_but_not_before_it_set_off():
+    """A relay held on its edge as long as a stuck one becomes a relay there; held on the
+    centre it waits to leave (under way only once the world asked its direction)."""
+    robot = ConnectedExplorer(0, make_minds("incidence-dfs", 1, None)[0], Tether(0, range_m=1.0))
+    robot.mode, robot.plan = TRANSIT, [("go", 1.0)]
+    recruit = robot._waits.recruit
+    for tick in range(1, recruit + 2):
+        robot.after(tick, None, False, {}, held=True)
+    assert robot.mode == TRANSIT  # never under way
+    robot.direction(0.4)
+    for tick in range(recruit + 2, 2 * recruit + 3):
+        robot.after(tick, None, False, {}, held=True)
+    assert robot.mode == RELAY
+
+
 # ---------------------------------------------------------------------------- the tether
+def test_a_robot_past_its_leash_may_still_come_back():
+    """A body that coasted past the leash may take steps that bring its parent nearer,
+    never ones that take it farther."""
+    t = Tether(0, range_m=1.0)
+    around = {BASE: (-1.01, 0.0)}
+    assert t.may_step((-0.004, 0.0), around)
+    assert not t.may_step((0.004, 0.0), around) and not t.may_step((0.0, 0.01), around)
+
+
+def test_a_robot_that_lost_its_parent_to_a_wall_asks_a_still_neighbour():
+    """Rule 4 with ``cut``: the leash allows the step, but a wall took the parent's link
+    on it before; a still neighbour in range is asked to adopt."""
+    t = Tether(2, range_m=1.0, parents=(0,))
+    around = {0: (-0.5, 0.0), 1: (0.6, 0.0)}
+    t.hear(1, [Message(Beat((BASE,), 1, True, 0, 0), sender=0),
+               Message(Beat((BASE,), 1, True, 0, 0), sender=1)], around)
+    assert t.ask(1, (0.004, 0.0), around) == []
+    assert t.ask(2, (0.004, 0.0), around, cut={0}) == [Message(Adopt(), to=1)]
+
+
+def test_a_robot_setting_off_adopts_nobody():
+    t = Tether(1, range_m=1.0)
+    assert t.hear(5, [Message(Adopt(), to=1, sender=2)], {2: (0.5, 0.0)}, willing=False) == []
+    assert not t.holding
+
+
 def test_the_leash_keeps_the_parent_in_range():
     t = Tether(0, range_m=1.0)
     t.hear(1, [Message(Beat((), 0, True, 0, 0), sender=BASE)], {BASE: (-0.9, 0.0)})
@@ -205,11 +276,11 @@ def test_the_readme_table_script_runs():
 
 
 # ---------------------------------------------------------------------------- embodied
-def embodied(arena: str, robots: int, range_m: float, **config):
+def embodied(arena: str, robots: int, range_m: float, seed: int | None = None, **config):
     from mjswarm.experiments.exploration import EmbodiedConfig, explore_embodied
 
     return explore_embodied(load_arena(arena), robots, config=EmbodiedConfig(
-        radio_range_m=range_m, connectivity="connected", **config))
+        radio_range_m=range_m, connectivity="connected", **config), seed=seed)
 
 
 def test_embodied_with_range_to_spare_changes_nothing():
@@ -218,6 +289,16 @@ def test_embodied_with_range_to_spare_changes_nothing():
     result = embodied("arena1", 2, 3.0)
     assert result.completed and result.map_correct
     assert (result.makespan, result.total_traversals) == (5, 10)
+    assert result.collisions == 0 and result.cut_ticks == 0 and result.connected_share == 1.0
+
+
+def test_embodied_relays_carry_a_team_the_tether_alone_stopped():
+    """arena1, 3 robots at 2.5 m, 10 cm/s, seed 5: v8 lies 2.7 m from the base, so a robot
+    must stand between (the tether alone, before rule 6 ran on bodies, declared the team
+    infeasible with 8 of 9 edges explored). Now it completes the true map, with 0
+    contacts and every robot linked to the base in every tick."""
+    result = embodied("arena1", 3, 2.5, seed=5, speed_m_s=0.1)
+    assert result.completed and result.map_correct and not result.infeasible
     assert result.collisions == 0 and result.cut_ticks == 0 and result.connected_share == 1.0
 
 

@@ -114,11 +114,11 @@ def test_measured_angles_are_in_the_robots_own_frame():
     assert np.max(errors) < 3.0
 
 
-@pytest.mark.parametrize("drive_m", [0.05, 0.3, 0.7, 1.2])
+@pytest.mark.parametrize("drive_m", [0.05, 0.3, 0.7, 1.2, math.inf])
 def test_a_robot_turned_back_part_way_arrives_where_it_left_by_the_edge_it_left_along(drive_m):
     """Rule 6's walks back (:meth:`Navigator.turn_back`): turned back while leaving (5 cm),
-    short of its corridor (0.3 m) or on its lane (0.7 m, and 1.2 m, past the wall's end at
-    the far vertex of a 1.5 m edge), the robot is back on the centre it left, measures the
+    short of its corridor (0.3 m), on its lane (0.7 m, and 1.2 m, past the wall's end at
+    the far vertex of a 1.5 m edge) or arriving there (a second into its arrival), the robot is back on the centre it left, measures the
     same edges, and reports the edge it left along as the one it came by."""
     spec = load_arena("lattice:2x2:1.5")
     x, y = spec.vertices[spec.root]
@@ -132,10 +132,13 @@ def test_a_robot_turned_back_part_way_arrives_where_it_left_by_the_edge_it_left_
     assert len(first) == 2
     nav.depart(first[0])
     start = nav.odometry.distance_m
-    while nav.odometry.distance_m - start < drive_m:
+    while nav.odometry.distance_m - start < drive_m and nav.state is not NavigatorState.ARRIVING:
         driver.step()
-        assert nav.state in (NavigatorState.LEAVING, NavigatorState.ON_EDGE), nav.events[-1]
-    assert nav.turn_back()
+    for _ in range(50 if nav.state is NavigatorState.ARRIVING else 0):
+        driver.step()
+        assert nav.state in (NavigatorState.LEAVING, NavigatorState.ON_EDGE,
+                             NavigatorState.ARRIVING), nav.events[-1]
+    nav.turn_back()
     for _ in range(MAX_TICKS_PER_LEG):
         if nav.state is NavigatorState.AT_VERTEX:
             break

@@ -8,8 +8,9 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from algorithms.exploration.entry import EntryGranted, LeftVertex, VertexClear
-from mjswarm.arena import load_arena
+from algorithms.exploration.entry import (EntryGranted, EntryRequest, LeftVertex, TurnedBack,
+                                          VertexClear, Withdraw)
+from mjswarm.arena import incidence_angle, load_arena
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
 from mjswarm.experiments.stations import VertexStations
 from mjswarm.worlds.graphworld import make_minds
@@ -90,9 +91,10 @@ def _wait_for_graph(stations: VertexStations) -> nx.DiGraph:
 
 @pytest.mark.parametrize("seed", range(40))
 def test_no_circular_wait_survives_a_grant(seed):
-    """Random teams on the centres of a lattice, each wanting a random neighbour: after
-    one grant no cycle of robots standing on centres waits for each other (networkx
-    finds none), and every grant respects one robot per vertex."""
+    """Random teams on the centres of a lattice, each wanting a random neighbour, and
+    robots turned back on lanes (holding nothing) wanting a random vertex: after one grant
+    no cycle of robots waits for each other (networkx finds none), and every grant
+    respects one robot per vertex."""
     spec = load_arena("lattice:4x4")
     g = spec.graph()
     rng = np.random.default_rng(seed)
@@ -105,6 +107,8 @@ def test_no_circular_wait_survives_a_grant(seed):
         if rng.random() < 0.85:
             nbrs = sorted(g.neighbors(vertices[k]))
             stations.request(robot, vertices[k], nbrs[rng.integers(len(nbrs))], float(robot))
+    for robot in range(len(team), len(team) + rng.integers(0, 4)):  # on lanes
+        stations.request(robot, None, vertices[rng.integers(len(vertices))], rng.random() * 12)
     granted = stations.grant()
     assert len({v for _, v in granted}) == len(granted)
     assert all(stations.holder[v] == r for r, v in granted)
@@ -134,3 +138,93 @@ def test_a_swap_grants_both_robots_and_tells_each_its_vertex_is_not_yet_clear():
     run.uplink.step()
     assert [m.payload for m in run.uplink.receive_for(1)] == [VertexClear()]
     assert run.uplink.receive_for(0) == []
+
+
+def test_a_withdrawn_request_is_dropped(lattice):
+    lattice.occupy(0, "v0_0")
+    lattice.occupy(1, "v0_1")
+    lattice.request(0, "v0_0", "v0_1", 1.0)
+    lattice.withdraw(0)
+    lattice.release(1, "v0_1")
+    assert lattice.grant() == [] and lattice.holder == {"v0_0": 0}
+
+
+def _on_fig9(k: int = 2) -> tuple[EmbodiedExploration, str, str]:
+    run = EmbodiedExploration(load_arena("fig9"), make_minds("incidence-dfs", k),
+                              EmbodiedConfig(), 0)
+    run.launch_queue.clear()
+    u, w = load_arena("fig9").edges[0]
+    return run, u, w
+
+
+def _granted(run, i, u, w):
+    """Robot ``i`` on ``u`` asks for the edge to ``w`` and gets it."""
+    run.target[i] = u
+    run.stations.occupy(i, u)
+    run._station_receives(i, EntryRequest(_angle(run, u, w)))
+    run.before_step(run.loop)
+    run.uplink.step()
+    return [m.payload for m in run.uplink.receive_for(i)]
+
+
+def _angle(run, u, w):
+    return incidence_angle(run.spec, u, w)
+
+
+def test_a_robot_turning_back_short_of_its_corridor_gets_its_vertex_back_at_once():
+    run, u, w = _on_fig9()
+    assert _granted(run, 0, u, w) == [EntryGranted(True, _angle(run, u, w))]
+    run._station_receives(0, TurnedBack(from_lane=False))
+    run.uplink.step()
+    assert [m.payload for m in run.uplink.receive_for(0)] == [EntryGranted(clear=True)]
+    assert run.target[0] == u and run.leaving[0] is None and run.stations.holder == {u: 0}
+
+
+def test_a_robot_turning_back_from_its_lane_waits_for_its_vertex_like_a_centre():
+    """Once it left ``u``'s area (``u`` went to another robot), its walk back is a request
+    from its lane: granted when ``u`` is free, with the vertex ahead freed at once."""
+    run, u, w = _on_fig9()
+    _granted(run, 0, u, w)
+    run._station_receives(0, LeftVertex())
+    run.stations.occupy(1, u)
+    run.target[1] = u
+    run._station_receives(0, TurnedBack(from_lane=True))
+    assert run.stations.holder == {u: 1} and run.stations.requests[0].at is None
+    run.before_step(run.loop)
+    assert run.stations.holder == {u: 1}  # u is held: it waits
+    run.stations.release(1, u)
+    run.before_step(run.loop)
+    run.uplink.step()
+    assert [m.payload for m in run.uplink.receive_for(0)] == [EntryGranted(True, None)]
+    assert run.target[0] == u and run.stations.holder == {u: 0}
+
+
+def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws():
+    """In a swap each robot was given the other's vertex: one that then asks to turn back
+    into its old area gets no answer (it goes on), and one that withdraws leaves the
+    other waiting until it has left its area."""
+    run, u, w = _on_fig9()
+    run.target = [u, w]
+    run.stations.occupy(0, u)
+    run.stations.occupy(1, w)
+    for i, (a, b) in enumerate(((u, w), (w, u))):
+        run._station_receives(i, EntryRequest(_angle(run, a, b)))
+    run.before_step(run.loop)
+    run.uplink.step()
+    for i in (0, 1):
+        run.uplink.receive_for(i)
+    run._station_receives(0, TurnedBack(from_lane=False))
+    run.uplink.step()
+    assert run.uplink.receive_for(0) == [] and run.target == [w, u]
+    run._station_receives(1, Withdraw())
+    assert run.target[1] == w and run.leaving[1] == w  # robot 0 still waits for it to go
+    assert run.stations.holder == {w: 0}
+    run.uplink.step()
+    assert run.uplink.receive_for(0) == []  # no VertexClear for robot 0
+
+
+def test_a_withdrawn_clear_grant_is_taken_back():
+    run, u, w = _on_fig9()
+    _granted(run, 0, u, w)
+    run._station_receives(0, Withdraw())
+    assert run.target[0] == u and run.leaving[0] is None and run.stations.holder == {u: 0}

@@ -20,6 +20,26 @@ and every message is counted with the radio's. The protocol, from the robot's si
    waits where its lane's wall ends, out of ``w``'s area.
 4. A robot that stops for good sends :class:`Halted`: the station drops its request and
    holds (a body left in a vertex area keeps that vertex closed: the station sees it).
+5. Relays (rule 6 of :mod:`algorithms.exploration.relay`, ours). A relay's last leg ends
+   part-way, where its requester is: its :class:`EntryRequest` says so (``part_way``),
+   and the station lets it onto the lane at once without giving it the vertex ahead
+   (:class:`EntryGranted` with ``clear`` False: it never enters that area). A robot that
+   must walk back sends :class:`TurnedBack`, and the station frees the vertex ahead. Near
+   the vertex behind (``from_lane`` False: short of its corridor, or too near for a
+   U-turn clear of that area) it asks to return there and turns once it has the grant:
+   at once if it never left that area, and no answer if the station gave it to another
+   robot meanwhile (a swap: it goes on, and turns farther along); else when the vertex is
+   free. Turned on its lane (``from_lane`` True, sent once it follows its new lane, out of
+   the area ahead), it waits for the vertex behind where its new lane's wall ends; both
+   wait as a request from a centre does. A robot granted a clear vertex while it
+   must hold (rule 2 of the tether: it was adopted while it waited) sends :class:`Withdraw`:
+   the station takes the grant back, and the robot asks again once it has no children, so
+   that it does not keep two vertex areas while it stands in one (a robot granted a
+   vertex not yet clear keeps it: a swap needs it to leave as soon as it may). A robot
+   that sets out as a relay from a centre where it waits for a grant withdraws too, then
+   asks for the way its mission takes. A grant names the request's angle, so that one
+   overtaken by a withdrawal is known as such. A withdrawn swap leaves the other robot
+   waiting, as before, until this one has left the vertex area it was given.
 
 A station serves the beacon of its vertex only to the robot it granted (or launched
 there): a robot that arrives anywhere else finds no beacon and stops.
@@ -34,15 +54,31 @@ STATION = "station"
 
 
 class EntryRequest(NamedTuple):
-    """Robot → station: let me leave my vertex along the edge at ``angle_rad``."""
+    """Robot → station: let me leave my vertex along the edge at ``angle_rad``
+    (``part_way``: only onto its lane, not into the vertex at the far end)."""
 
     angle_rad: float
+    part_way: bool = False
+
+
+class Withdraw(NamedTuple):
+    """Robot → station: drop my request, or take back the vertex you granted me; I have
+    not left my vertex."""
+
+
+class TurnedBack(NamedTuple):
+    """Robot → station: I walk back along my edge; free the vertex ahead, give me the one
+    I left (``from_lane``: I turned on my lane; else I am still in its area)."""
+
+    from_lane: bool
 
 
 class EntryGranted(NamedTuple):
-    """Station → robot: go; ``clear`` says whether the vertex ahead is already clear."""
+    """Station → robot: go; ``clear`` says whether the vertex ahead is already clear;
+    ``angle_rad`` is the request's (None: the vertex it walks back to)."""
 
     clear: bool
+    angle_rad: float | None = None
 
 
 class EntryDenied(NamedTuple):

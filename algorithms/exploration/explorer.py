@@ -12,15 +12,23 @@ It composes, fed only by its own observation:
 * optionally a :class:`~algorithms.connectivity.ConnectivityTable` (seed 004) kept over
   its radio: its belief whether a single robot's loss would cut it off the reference;
 * optionally a :class:`~algorithms.exploration.tether.Tether` (issue 17's connected
-  exploration, rules 1-5): it reads its radio neighbours' ranges and bearings
-  (``Observation.detections``), and it does not drive a control period's distance
-  (``v dt`` ahead) that the leash forbids: it stands (no turn either, so that it keeps its
-  lane), asks for adoption, and declares the exploration infeasible on a stall (rule 5),
-  after which it stands for good. The leash knows ranges, not walls: when a wall comes
-  between it and a parent (the link is gone from its radio neighbours), it drives its
-  moves since the link was last there backwards, and then stands as if the leash had
-  stopped it until it has a new parent (ours). Relays on demand (rule 6) are not part of
-  the embodied explorer yet.
+  exploration), in the graph world's :class:`~algorithms.exploration.relay.ConnectedExplorer`
+  (rules 1-6, the same object around the same strategy): it reads its radio neighbours'
+  ranges and bearings (``Observation.detections``), and it does not drive a control
+  period's distance (``v dt`` ahead) that the leash forbids: it stands (no turn either, so
+  that it keeps its lane), asks for adoption, calls relays, serves as one, retreats, and
+  declares the exploration infeasible on a stall (rule 5), after which it stands for good.
+  Its progress along a leg is the odometry's distance since it left the vertex; a walk
+  back is the navigator's :meth:`~algorithms.navigation.Navigator.turn_back`, announced to
+  the stations (:class:`~algorithms.exploration.entry.TurnedBack`), and a relay's last leg
+  asks only for the lane (``EntryRequest.part_way``). It is held (rule 6's "held on the
+  way") when it wants to move and the speed rule or vertex entry stops it. The leash knows
+  ranges, not walls: when a wall comes between it and a parent (the link is gone from its
+  radio neighbours), it drives its moves since the link was last there backwards (never
+  back into a vertex area it has given up: the moves from before are forgotten), and then
+  stands as if the leash had stopped it (so it calls a relay, rule 6) until it has a new
+  parent or sets out on a new leg; it may still walk back along its leg (rule 6), unless a
+  wall cut a link on the way back too (ours).
 
 Choices beyond the paper (the loop functions in :mod:`mjswarm.experiments.exploration` say the rest):
 
@@ -46,6 +54,7 @@ from typing import Any, NamedTuple
 
 from algorithms.collision import CollisionRule
 from algorithms.exploration.base import AngleMismatch, Decision, Strategy
+from algorithms.exploration.relay import ConnectedExplorer
 from algorithms.exploration.tether import Tether
 from algorithms.exploration.entry import (
     STATION,
@@ -54,11 +63,24 @@ from algorithms.exploration.entry import (
     EntryRequest,
     Halted,
     LeftVertex,
+    TurnedBack,
     VertexClear,
+    Withdraw,
 )
-from algorithms.navigation import ArenaConventions, NavEvent, Navigator, RobotCalibration
+from algorithms.navigation import (
+    ArenaConventions,
+    NavEvent,
+    Navigator,
+    NavigatorState,
+    RobotCalibration,
+)
 from algorithms.navigation.percept import percept
 from algorithms.robot import Command, Controller, Message, Observation
+
+
+#: A relay stops this far short of where its requester stood on their lane (m): two body
+#: diameters, so that a requester backing out of a wall's shadow does not reach it.
+RELAY_SPACING_M = 0.3
 
 
 class VertexCall(NamedTuple):
@@ -98,11 +120,22 @@ class Explorer(Controller):
         self.idle_wait_s = idle_wait_s
         self.table = table
         self.tether = tether
+        #: its connected exploration (rules 1-6) around ``strategy``; None without a tether
+        self.connected = None if tether is None else ConnectedExplorer(
+            tether.me, strategy, tether, spacing=RELAY_SPACING_M)
+        self._on_edge = False  # between a departure and the next arrival
+        self._left_at_m = 0.0  # odometry distance where it left its vertex
+        self._turning = False  # walking back along its edge (rule 6)
+        self._turn_asked = False  # asked to return to the vertex whose area it is still in
+        self._tell_turn = False  # turned on its lane: tells the stations once on the new lane
+        self._held = False  # wanted to move, and the speed rule or vertex entry held it
         #: whether its tether declared the exploration infeasible (rule 5)
         self.infeasible = False
-        self._progressed = False
         self._trail: list[tuple[float, float]] = []  # moves since its parents were all linked
-        self._occluded = False  # lost a parent's link to a wall: waits for a new parent
+        #: the ways along its leg (+1 on, -1 back) in which a wall cut a parent's link,
+        #: and those parents
+        self._occluded: set[int] = set()
+        self._cut: set = set()
         self._parents_then = None if tether is None else tether.parents
         self.control_dt_s = control_dt_s
         self.nav = Navigator(calibration, conventions, 0.0, speed_m_s, turn_rate_rad_s)
@@ -117,6 +150,9 @@ class Explorer(Controller):
         self._handled = 0
         self._idle_since: float | None = None
         self._departure: float | None = None  # angle of the edge it waits to take
+        self._asked: EntryRequest | None = None  # its request, until it departs
+        self._trips = 0  # relay missions it has set out on (rule 6)
+        self._withdrawn = False  # gave a grant back: it holds (asks again once it may go)
         self._leaving = False  # holds the vertex it left until it is in its corridor
         self._clear = True  # the vertex it goes to is clear of its previous holder
 
@@ -130,16 +166,25 @@ class Explorer(Controller):
         if self.table is not None:
             robots = [m for m in observation.inbox if m.sender != STATION]
             out += self.table.tick(now, robots, observation.neighbors)
+        for m in observation.inbox:
+            if m.sender == STATION:
+                self._from_station(m.payload, out)
         around = {}
         if self.tether is not None:
             around = {j: (d.range_m * math.cos(d.bearing_rad), d.range_m * math.sin(d.bearing_rad))
                       for j, d in observation.detections.items()}
             tied = [m for m in observation.inbox if m.sender != STATION]
-            out += self.tether.hear(now, tied, around)
-        for m in observation.inbox:
-            if m.sender == STATION:
-                self._from_station(m.payload, out)
+            # leaving a vertex (granted the next one) it adopts nobody: it would hold both
+            out += self.connected.hear(now, tied, around, willing=not self._leaving)
+        if self._withdrawn and not self.tether.children:
+            self._withdrawn = False  # free to go: ask again
+            out.append(Message(self._asked, STATION))
+        if self.tether is not None and self.connected.relay_trips != self._trips:
+            self._trips = self.connected.relay_trips
+            self._set_out(observation.time_s, out)
         if self.halted is not None or self.declared or self.infeasible:
+            if self.connected is not None:
+                self.connected.retire()  # it serves as nobody's relay
             return self._stand(now, out, around)
         if self.tether is not None and not all(q in around for q in self.tether.parents):
             return self._retrace(now, out, around)
@@ -149,27 +194,42 @@ class Explorer(Controller):
         wanted = None
         if command.v_m_s != 0.0:
             step = (command.v_m_s * self.control_dt_s, 0.0)  # in its own frame
-            if self._occluded or not self.tether.may_step(step, around):
+            if self._way in self._occluded or not self.tether.may_step(step, around):
                 wanted, command = step, Command(messages=command.messages)
             else:
                 self._trail.append((command.v_m_s, command.omega_rad_s))
         if self.tether.parents != self._parents_then:  # a new parent: try again
-            self._occluded, self._trail = False, []
+            self._occluded, self._trail, self._cut = set(), [], set()
         self._parents_then = self.tether.parents
         out = list(command.messages)
-        out += self.tether.ask(now, wanted, around)
-        out.append(self.tether.beat(now, command.v_m_s != 0.0, self._progressed,
-                                    len(self.strategy.map_edges())))
-        self._progressed = False
+        out += self.connected.after(now, wanted, command.v_m_s != 0.0, around, self._held,
+                                    self._cut if self._way in self._occluded else ())
         if self.tether.stalled(now):
             self.infeasible = True
         return command._replace(messages=tuple(out))
+
+    def _set_out(self, now_s: float, out: list[Message]) -> None:
+        """Rule 6: it accepted a relay mission. On an edge its plan starts with the walk
+        back; on a centre where it waits for a grant it withdraws its request (the leg
+        it had decided on is walked back at once: it never left) and decides anew."""
+        if self._departure is None:
+            if self.nav.state is NavigatorState.AT_VERTEX and self._idle_since is not None:
+                self._idle_since = -math.inf  # idle: it sets out at once
+            return
+        if self.rule is not None:
+            out.append(Message(Withdraw(), STATION))
+        self._departure, self._asked, self._withdrawn = None, None, False
+        self.connected.arrived_back()
+        # it stands where it made its last call: that beacon (its grant may have moved
+        # the station's record on already)
+        self._vertex_call(self.calls[-1].beacon, now_s, False, out, back=True)
 
     def _retrace(self, now: int, out: list[Message], around) -> Command:
         """A parent's link is gone (a wall came between them: the leash knows ranges, not
         walls): drive its last moves backwards until the link is back, then wait for a new
         parent as if the leash had stopped it."""
-        self._occluded = True
+        self._occluded.add(self._way)
+        self._cut |= {q for q in self.tether.parents if q not in around}
         if not self._trail:
             return self._stand(now, out, around)
         v, w = self._trail.pop()
@@ -177,8 +237,8 @@ class Explorer(Controller):
         return Command(-v, -w, messages=tuple(out))
 
     def _stand(self, now: int, out: list[Message], around) -> Command:
-        """Stand still (stopped, done, or infeasible); a tethered robot keeps beating, so
-        that its children and the stall gossip go on."""
+        """Stand still (stopped, done, infeasible, or cut off with no move to undo); a
+        tethered robot keeps beating, so that its children and the stall gossip go on."""
         if self.tether is not None:
             out += self.tether.ask(now, None, around)
             out.append(self.tether.beat(now, False, False, len(self.strategy.map_edges())))
@@ -186,28 +246,69 @@ class Explorer(Controller):
 
     def _drive(self, observation: Observation, out: list[Message]) -> Command:
         """Navigator, vertex calls, the speed rule and vertex entry: this tick's command."""
-        v, w = self.nav.update(percept(observation.line_m, observation.ir_m,
-                                       observation.encoder_rad, self.calibration.line_floor_m))
+        nav, sense = self.nav, self._sense(out)
+        v, w = nav.update(percept(observation.line_m, observation.ir_m,
+                                  observation.encoder_rad, self.calibration.line_floor_m))
         self._on_events(observation, out)
         if self.halted is not None or self.declared:
             return Command(messages=tuple(out))
+        if sense == 0:  # rule 6: a relay, or waiting to: it stands on its edge
+            v = w = 0.0
         speed = self.cruise_m_s
-        nav = self.nav
         if self.rule is not None:
             if nav.on_lane:  # the rule governs edge traversals
                 speed = self.rule.update(observation.bearings)
             else:
                 self.rule.forget_bearings()
+            # a vertex area it gives up is one it never backs into (``_retrace``)
             if self._leaving and nav.in_corridor:  # clear of the vertex it left
                 out.append(Message(LeftVertex(), STATION))
-                self._leaving = False
+                self._leaving, self._trail = False, []
+            if self._tell_turn and nav.on_lane:  # out of the area ahead, on its way back
+                out.append(Message(TurnedBack(from_lane=True), STATION))
+                self._tell_turn, self._trail = False, []
             if nav.at_vertex_area and not self._clear:
                 speed = 0.0  # the previous holder of the vertex ahead is still leaving it
         self.speed_m_s = speed
+        # held: the speed rule or vertex entry stops it, or it waits for its grant
+        self._held = (v != 0.0 and speed == 0.0) or self._departure is not None
         if v != 0.0:  # translations run at the rule's speed; turns in place do not
             factor = speed / self.cruise_m_s
             v, w = v * factor, w * factor
         return Command(v, w, messages=tuple(out))
+
+    @property
+    def _way(self) -> int:
+        """Which way along its leg it drives: +1 on, -1 back (rule 6)."""
+        return -1 if self._turning else 1
+
+    def _sense(self, out: list[Message]) -> int:
+        """Rule 6 on an edge: +1 on, 0 stand, -1 back. A walk back starts at once on its
+        lane (a U-turn; the stations hear of it once it follows its new lane) or without
+        vertex entry; nearer the vertex behind (a U-turn there would reach into its area),
+        once the station gives it that vertex (if it gave it to another robot in a swap,
+        it goes on, and turns farther along)."""
+        cx, nav = self.connected, self.nav
+        if cx is None or not self._on_edge:
+            return 1
+        sense = cx.direction(nav.odometry.distance_m - self._left_at_m)
+        if sense < 0 and not self._turning:
+            if self.rule is None or nav.room_to_turn or nav.state is NavigatorState.ARRIVING:
+                self._turn_back(granted=self.rule is None)
+            elif not self._turn_asked:
+                self._turn_asked = True
+                out.append(Message(TurnedBack(from_lane=False), STATION))
+            if not self._turning:
+                return 1
+        return sense
+
+    def _turn_back(self, granted: bool) -> None:
+        """Start the walk back (``granted``: the vertex behind is its own already)."""
+        self.nav.turn_back()
+        self._turning, self._leaving, self._clear = True, False, granted
+        self._tell_turn = not granted
+        if self.rule is not None:
+            self.rule.crossed_vertex()  # a new traversal begins: eq. (34)
 
     def telemetry(self) -> dict[str, float]:
         """Its speed (m/s), vertex calls so far, and whether it is stopped for good."""
@@ -223,44 +324,57 @@ class Explorer(Controller):
             if event.kind is NavEvent.ARRIVED:
                 if self.rule is not None:
                     self.rule.crossed_vertex()  # eq. (34)
-                # the scan right after a launch is no arrival: the robot came by no edge
-                self._vertex_call(observation, nav.arrived_angle is not None, out)
+                back, self._turning, self._on_edge = self._turning, False, False
+                self._turn_asked = False
+                if back:
+                    self.connected.arrived_back()
+                # the scan right after a launch is no arrival: the robot came by no edge;
+                # nor is a walk back (it traversed none)
+                self._vertex_call(observation.beacon, observation.time_s,
+                                  nav.arrived_angle is not None, out, back)
             elif event.kind is NavEvent.LOST:
                 self._halt(str(event), out)
         if (self._idle_since is not None
                 and observation.time_s - self._idle_since >= self.idle_wait_s):
             self._idle_since = None
-            self._vertex_call(observation, False, out)
+            self._vertex_call(observation.beacon, observation.time_s, False, out)
 
-    def _vertex_call(self, observation: Observation, arrived: bool, out: list[Message]) -> None:
-        """The strategy's vertex call: beacon in, decision out."""
-        beacon, nav = observation.beacon, self.nav
+    def _vertex_call(self, beacon, now_s: float, arrived: bool, out: list[Message],
+                     back: bool = False) -> None:
+        """The strategy's vertex call (through its connected exploration, if any): beacon
+        in, decision out. ``back``: it walked back to this vertex (rule 6)."""
+        nav, cx = self.nav, self.connected
         if beacon is None:
             self._halt("no beacon where it arrived (off the vertex centre, or not the "
                        "vertex it was granted)", out)
             return
+        arrived_by = nav.arrived_angle if arrived else None
         try:
-            decision = self.strategy.on_vertex(beacon, nav.edge_angles,
-                                               nav.arrived_angle if arrived else None)
+            if cx is None:
+                decision = self.strategy.on_vertex(beacon, nav.edge_angles, arrived_by)
+            else:
+                cx.arrive(beacon, nav.edge_angles, arrived_by)
+                decision = cx.on_vertex(beacon, nav.edge_angles, arrived_by)
         except AngleMismatch as exc:  # its heading reference is broken (e.g. after a crash)
             self._halt(f"its angles match no edge of the beacon: {exc}", out)
             return
         except ValueError as exc:  # a beacon it cannot reconcile (e.g. a wiped one)
             self._halt(f"its strategy failed: {exc}", out)
             return
-        if self.strategy.stored_angles is not None:  # re-anchoring
+        consulted = cx is None or cx.consulted
+        if consulted and self.strategy.stored_angles is not None:  # re-anchoring
             nav.reanchor(self.strategy.stored_angles)
-        self.calls.append(VertexCall(observation.time_s, beacon, arrived, decision))
-        self._progressed = arrived
+        self.calls.append(VertexCall(now_s, beacon, arrived and not back, decision))
         if decision.action == "go":
             self._departure = min(nav.edge_angles, key=lambda a: abs(
                 math.remainder(a - decision.angle, 2 * math.pi)))
             if self.rule is None:
                 self._depart()
             else:
-                out.append(Message(EntryRequest(decision.angle), STATION))
+                self._asked = EntryRequest(decision.angle, cx is not None and cx.stops_part_way)
+                out.append(Message(self._asked, STATION))
         elif decision.action == "idle":
-            self._idle_since = observation.time_s
+            self._idle_since = now_s
         elif decision.action == "done":
             self.declared = True
         else:
@@ -268,9 +382,22 @@ class Explorer(Controller):
 
     def _from_station(self, payload: Any, out: list[Message]) -> None:
         if isinstance(payload, EntryGranted):
+            if payload.angle_rad is not None and (
+                    self._asked is None or payload.angle_rad != self._asked.angle_rad):
+                return  # a grant its withdrawal overtook
             self._clear = payload.clear
-            self._leaving = True
-            self._depart()
+            if self._turn_asked:  # it may return to the vertex it is still leaving
+                self._turn_asked = False
+                if self._turning:  # it turned in its corridor meanwhile: no lane request
+                    self._tell_turn = False
+                else:
+                    self._turn_back(granted=True)
+            elif payload.clear and self.tether is not None and self.tether.children:
+                self._withdrawn = True  # it must hold (rule 2): give the grant back
+                out.append(Message(Withdraw(), STATION))
+            elif not self._turning:  # else: the vertex it walks back to is its own now
+                self._leaving = True
+                self._depart()
         elif isinstance(payload, VertexClear):
             self._clear = True
         elif isinstance(payload, EntryDenied):
@@ -278,7 +405,9 @@ class Explorer(Controller):
 
     def _depart(self) -> None:
         self.nav.depart(self._departure)
-        self._departure = None
+        self._departure, self._asked = None, None
+        self._on_edge, self._left_at_m = True, self.nav.odometry.distance_m
+        self._occluded, self._trail, self._cut = set(), [], set()  # a new leg: new walls
 
     def _halt(self, reason: str, out: list[Message]) -> None:
         if self.halted is None:

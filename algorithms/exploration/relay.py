@@ -7,8 +7,10 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   step and could not for ``RECRUIT_AFTER_UNITS`` floods ``RelayWanted`` with where it is: its loop-free route
   from the root (the legs it took, each named by the beacon it started from and the
   incidence angles at both ends), the leg it is on, and how far along it is.
-* **Offer.** A robot that is free (exploring, without children, and itself stuck as long,
-  or idle at a vertex) floods ``RelayOffer``. A robot with a request of its own offers only
+* **Offer.** A robot that is free (exploring, without children, and itself stuck or held
+  by the world as long, or idle at a vertex) floods ``RelayOffer``. (A robot held on a
+  vertex centre with its request for the next vertex open sets off on that grant when it
+  comes, and walks back at once, as a relay that is on its way anywhere does.) A robot with a request of its own offers only
   to requesters with a smaller index, and then drops its request, so one of two stuck
   robots always serves the other.
 * **Accept.** The requester takes the first offer (the lowest index among those of one
@@ -30,7 +32,8 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
 
 * **Held on the way.** A relay that the world holds on its way (a body ahead on its lane,
   a vertex area it may not enter yet) for as long as it waits at a leash stops where it
-  is and relays from there, as one the leash stops.
+  is and relays from there, as one the leash stops. A robot held by the world stands by
+  necessity, for as long as what holds it lasts, so it counts as settled (below).
 
 * **Settled robots adopt.** A robot's beat says it stands still only when it stands by
   its own choice: a relay, in reserve, idle, holding, or stuck at the end of its leash.
@@ -42,15 +45,13 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
 The walk is the robot's own: it follows incidence angles from vertex to vertex as seed
 003's robots do; routes name vertices by their beacons (each beacon's hardware identity).
 Walking back along an edge is the world's: the graph world reverses, a MuJoCo robot turns
-onto the opposite lane (:meth:`~algorithms.navigation.Navigator.turn_back`); a robot that
-can only go on (it is arriving at the vertex ahead) walks back from there along the edge
-it came by. The waits are in time units, so they keep their meaning at any control rate.
+onto the opposite lane (:meth:`~algorithms.navigation.Navigator.turn_back`). The waits are in time units, so they keep their meaning at any control rate.
 Flooded messages are forwarded once by every robot and by the base.
 """
 
 from __future__ import annotations
 
-from collections.abc import Hashable, Mapping, Sequence
+from collections.abc import Collection, Hashable, Mapping, Sequence
 from typing import Any, NamedTuple
 
 from algorithms.exploration.base import IDLE, Decision, Strategy, go
@@ -71,8 +72,8 @@ RETREAT_AFTER_UNITS = RECRUIT_AFTER_UNITS + OFFER_TIMEOUT_UNITS
 #: How long a robot in reserve hears no request before it resumes its task.
 RESUME_AFTER_UNITS = 5.0
 
-EXPLORE, TRANSIT, RELAY, RETURN, RETREAT, RESERVE = (
-    "explore", "transit", "relay", "return", "retreat", "reserve")
+EXPLORE, TRANSIT, RELAY, RETURN, RETREAT, RESERVE, RETIRED = (
+    "explore", "transit", "relay", "return", "retreat", "reserve", "retired")
 
 
 class Leg(NamedTuple):
@@ -154,11 +155,13 @@ class ConnectedExplorer:
     ``tether.may_step``; then :meth:`after`. ``progress`` (how far along its leg it is) is
     the robot's odometry, in the world's measure: the share of the edge in the graph
     world, metres driven since it left the vertex on the MuJoCo robots (a robot compares
-    only its own progress with a requester's, on the same leg).
+    only its own progress with a requester's, on the same leg). A relay stops ``spacing``
+    short of where its requester stood (0 in the graph world; bodies need room).
     """
 
-    def __init__(self, index: int, mind: Strategy, tether: Tether) -> None:
+    def __init__(self, index: int, mind: Strategy, tether: Tether, spacing: float = 0.0) -> None:
         self.index = index
+        self.spacing = spacing
         self.mind = mind
         self.tether = tether
         self.flood = Flooder()
@@ -170,6 +173,7 @@ class ConnectedExplorer:
         self.idle = False
         self.stuck = 0  # ticks it wanted to step and the leash forbade it
         self.held = 0  # ticks it wanted to move and the world held it
+        self.under_way = False  # on an edge (the world has asked its direction since it left)
         self._waits = Waits.at(tether.ticks_per_unit)
         #: whether its last vertex call asked its strategy (else: it walked a plan)
         self.consulted = False
@@ -190,8 +194,9 @@ class ConnectedExplorer:
         self.relay_trips = 0
 
     # ------------------------------------------------------------------ messages
-    def hear(self, tick: int, inbox: Sequence[Message], around: Mapping) -> list[Message]:
-        out = self.tether.hear(tick, inbox, around)
+    def hear(self, tick: int, inbox: Sequence[Message], around: Mapping,
+             willing: bool = True) -> list[Message]:
+        out = self.tether.hear(tick, inbox, around, willing)
         offers = []
         for m in inbox:
             p = m.payload
@@ -215,10 +220,15 @@ class ConnectedExplorer:
                 out.append(Message(accepted))
         return out
 
+    def retire(self) -> None:
+        """It stopped for good (done, stopped, or the team is infeasible): it still floods
+        and holds, and offers itself to nobody."""
+        self.mode, self.offer, self.request = RETIRED, None, None
+
     def _free(self) -> bool:
         if self.tether.children or self.offer is not None or self.tether.request is not None:
             return False
-        stuck = self.stuck >= self._waits.recruit
+        stuck = max(self.stuck, self.held) >= self._waits.recruit
         return (self.mode == RESERVE or (self.mode == EXPLORE and (stuck or self.idle))
                 or (self.mode == RETURN and stuck))
 
@@ -244,16 +254,12 @@ class ConnectedExplorer:
         w = self._wanted
         if self.task is None:  # exploring: suspend the task (else it is suspended already)
             self.task = (tuple(self.route), self.leg, self.progress)
-        self.plan = self._way(w.route, w.leg, w.progress)
+        self.plan = self._way(w.route, w.leg, max(0.0, w.progress - self.spacing))
         self.mode, self.stuck, self.idle, self.stop_at = TRANSIT, 0, False, None
         self.relay_trips += 1
 
     # ------------------------------------------------------------------ at a vertex
     def arrive(self, beacon, angles: Sequence[float], arrived_by: float | None) -> None:
-        if self.plan and self.plan[0] == ("back",):
-            # the world could not turn it back where it was (a body arriving at a vertex
-            # goes on to its centre): it walks back along the edge it came by
-            self.plan[0] = ("go", arrived_by)
         self._walked_to(beacon, arrived_by)
         if self.mode == EXPLORE:
             self.mind.arrive(beacon, angles, arrived_by)
@@ -285,6 +291,7 @@ class ConnectedExplorer:
 
     def _depart(self, beacon, angle: float) -> Decision:
         self.leg, self.backwards, self.progress = Leg(beacon, angle), False, 0.0
+        self.under_way = False
         return go(angle)
 
     def _walked_to(self, beacon, arrived_by: float | None) -> None:
@@ -294,7 +301,7 @@ class ConnectedExplorer:
                 self._root = beacon
             return
         done = Leg(self.leg.start, self.leg.depart, arrived_by)
-        self.leg = None
+        self.leg, self.under_way = None, False
         if self.backwards:
             return  # back at the start of the leg: the route is as it was
         starts = [leg.start for leg in self.route]
@@ -314,7 +321,7 @@ class ConnectedExplorer:
 
     def direction(self, progress: float) -> int:
         """+1 on along the edge, -1 back, 0 stay."""
-        self.progress = progress
+        self.progress, self.under_way = progress, True
         if self.mode == RELAY:
             return 0
         if self.plan and self.plan[0] == ("back",):
@@ -352,12 +359,13 @@ class ConnectedExplorer:
 
     # ------------------------------------------------------------------ end of tick
     def after(self, tick: int, wanted: Sequence[float] | None, moved: bool,
-              around: Mapping, held: bool = False) -> list[Message]:
+              around: Mapping, held: bool = False, cut: Collection = ()) -> list[Message]:
         """``wanted``: the step the leash forbade it (None if none); ``held``: it wanted to
-        move and the world held it (a body ahead on its lane, a vertex not yet entered)."""
+        move and the world held it (a body ahead on its lane, a vertex not yet entered);
+        ``cut``: parents whose link that step would lose to a wall (rule 4's ``cut``)."""
         self._tick = tick
         waits = self._waits
-        out = self.tether.ask(tick, wanted, around)
+        out = self.tether.ask(tick, wanted, around, cut)
         blocked = wanted is not None and not self.tether.children
         self.stuck = self.stuck + 1 if blocked else 0
         self.held = self.held + 1 if held else 0
@@ -371,7 +379,7 @@ class ConnectedExplorer:
                 out.append(Message(w))
         if self.offer is not None and tick - self.offer[2] > waits.offer:
             self.offer = None
-        if self.mode == TRANSIT and max(self.stuck, self.held) >= waits.recruit:
+        if self.mode == TRANSIT and self.under_way and max(self.stuck, self.held) >= waits.recruit:
             self._become_relay_here()
         if self.mode == RELAY:
             self._relay_tick(tick)
@@ -388,12 +396,12 @@ class ConnectedExplorer:
         return out
 
     def _settled(self) -> bool:
-        """Whether it stands by its own choice (a relay, in reserve, idle, holding, or stuck
-        at the end of its leash): only then does its beat say it is still, so that nobody
+        """Whether it stands by its own choice (a relay, in reserve, idle, holding, stuck
+        at the end of its leash, or held by the world): only then does its beat say it is still, so that nobody
         asks a robot that merely paused between two moves to adopt them (it would hold
         there for as long as its child needs it)."""
         return (self.mode in (RELAY, RESERVE) or self.idle or self.stuck > 0
-                or bool(self.tether.children))
+                or self.held > 0 or bool(self.tether.children))
 
     def _relay_tick(self, tick: int) -> None:
         if self.tether.children:

@@ -17,7 +17,8 @@ this combination):
    Its children are the robots whose last beat named it as parent, and those it adopted
    in the last ``ADOPT_GRACE_TICKS`` ticks (their first beat naming it is on its way).
 3. **Leash.** A robot without children takes a step only if, after the step, its parents
-   are within range ``R - margin`` of it. It knows where its radio neighbours are relative
+   are within range ``R - margin`` of it, or no farther than before (a body may coast a
+   little past the leash; it may always come back). It knows where its radio neighbours are relative
    to itself (a range-and-bearing sensor, as seed 001's robots have) and what its own
    step will be. Parents hold and the base never moves, so every tree link survives every
    tick, and nobody is ever cut off from the base.
@@ -49,7 +50,7 @@ tick.
 from __future__ import annotations
 
 import math
-from collections.abc import Hashable, Mapping, Sequence
+from collections.abc import Collection, Hashable, Mapping, Sequence
 from typing import NamedTuple
 
 from algorithms.robot import Message
@@ -122,9 +123,10 @@ class Tether:
 
     # -------------------------------------------------------------- one tick
     def hear(self, tick: int, inbox: Sequence[Message],
-             around: Mapping[Hashable, Sequence[float]]) -> list[Message]:
+             around: Mapping[Hashable, Sequence[float]], willing: bool = True) -> list[Message]:
         """Rules 1, 2 and the answering side of 4: read this tick's messages; ``around``:
-        where the radio neighbours are, relative to this robot (m)."""
+        where the radio neighbours are, relative to this robot (m); ``willing``: whether
+        it may adopt now (a robot that just set off refuses: the asker tries again)."""
         out: list[Message] = []
         self.heard = {}
         answer: tuple[Hashable, int] | None = None
@@ -134,7 +136,7 @@ class Tether:
                 self.heard[m.sender] = p
                 self.last_progress = max(self.last_progress, p.last_progress)
                 self.known_edges = max(self.known_edges, p.known_edges)
-            elif isinstance(p, Adopt) and self.request is None:
+            elif isinstance(p, Adopt) and self.request is None and willing:
                 self.adopted[m.sender] = tick
                 out.append(Message(Adopted(self.depth), to=m.sender))
             elif isinstance(p, Adopted) and self.request is not None and m.sender == self.request[0]:
@@ -156,17 +158,21 @@ class Tether:
 
     def may_step(self, step: Sequence[float], around: Mapping[Hashable, Sequence[float]]) -> bool:
         """Rule 3: whether to take ``step`` (m, this robot's displacement) given where its
-        radio neighbours are relative to it (m)."""
+        radio neighbours are relative to it (m). A step that brings no parent farther is
+        always allowed: a body that coasted past the leash (or read one tick old ranges)
+        may come back."""
         if self.children or self.request is not None:
             return False
-        return all(self._within(step, around.get(q)) for q in self.parents)
+        return all(self._within(step, around.get(q)) or _nearer(step, around.get(q))
+                   for q in self.parents)
 
     def ask(self, tick: int, step: Sequence[float] | None,
-            around: Mapping[Hashable, Sequence[float]]) -> list[Message]:
+            around: Mapping[Hashable, Sequence[float]], cut: Collection = ()) -> list[Message]:
         """Rule 4, asking side: after a tick in which this robot wanted to take ``step``
         (None: it wanted to stay) and did not, or could do with a parent nearer the base.
         With two parents it replaces one at a time: the first that forbids the step, else
-        the one farthest from the base (in hops)."""
+        the one farthest from the base (in hops). ``cut``: parents whose link the step
+        would lose for another reason than range (a wall, as the robot found)."""
         if self.request is not None or self.pinned:
             return []
         deepest = max(self.parents, key=lambda q: self._depth_of(q))
@@ -174,7 +180,8 @@ class Tether:
             if BASE not in self.parents and BASE in self.heard and self._within((0.0, 0.0), around.get(BASE)):
                 return self._request(BASE, tick, deepest)
             return []
-        blocking = [q for q in self.parents if step is not None and not self._within(step, around.get(q))]
+        blocking = [q for q in self.parents if step is not None
+                    and (q in cut or not self._within(step, around.get(q)))]
         best = None
         for r, beat in self.heard.items():
             if r in self.parents or not beat.still or r not in around:
@@ -221,6 +228,13 @@ class Tether:
         if offset is None:
             return False
         return math.hypot(offset[0] - step[0], offset[1] - step[1]) <= self.leash_m
+
+
+def _nearer(step: Sequence[float], offset: Sequence[float] | None) -> bool:
+    """Whether ``step`` (m) brings a neighbour at ``offset`` (m, None: unheard) no farther."""
+    if offset is None:
+        return False
+    return math.hypot(offset[0] - step[0], offset[1] - step[1]) <= math.hypot(*offset)
 
 
 def initial_parents(robot: int, need: int, first: int = 0) -> tuple[tuple, bool]:

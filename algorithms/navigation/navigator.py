@@ -140,8 +140,11 @@ class Navigator:
         self._tracks: list[float] = []  # effective track estimates, one per scan (m)
         self._lane: FollowLine | None = None
         self._left: tuple[float, float, float] | None = None  # centre x, y and angle it left by
+        self._lane_end: tuple[float, float, float] | None = None  # x, y, heading where its lane ended
+        self._returning = False  # turned back: on its way to the vertex it left
         self._wall_run_start: float | None = None
         self._wall_seen = False
+        self._wall_first_m: float | None = None  # odometry distance where its wall began
         self.vertex_detected = False
 
     # ---------------------------------------------------------------- control
@@ -161,34 +164,47 @@ class Navigator:
         self.state = NavigatorState.LEAVING
         self.events.append(NavigatorEvent(NavEvent.LEFT_VERTEX))
 
-    def turn_back(self) -> bool:
-        """Head back to the vertex it left; False while it arrives at the vertex ahead
-        (it goes on to that centre: the caller turns it back from there).
+    def turn_back(self) -> None:
+        """Head back to the vertex it left, from anywhere on its edge.
 
         In its corridor: a U-turn onto the opposite lane (face back, sidestep two lane
         offsets to the left, find the lane), then on as along any edge: the vertex is
-        where the new left wall ends, and the arrival is by the edge it left along. Short
+        where the new left wall ends (however little of it it saw: after a U-turn at the
+        far end of a short edge a few centimetres may be left; where its lane ends, if
+        it saw none), and the arrival is by the edge it left along.
+        Arriving at the vertex ahead (its lane ended): back by odometry to where the lane
+        ended, then the same U-turn. Short
         of its corridor (leaving, or on the lane before its wall): by odometry to the outer
         end of the spoke it left by, then in along the spoke to the centre and a scan, as
         on any arrival, by the edge it left along. Both
         are ours (seed 003's robots never turned back)."""
-        if self.state is NavigatorState.ARRIVING:
-            return False
-        if self.state not in (NavigatorState.LEAVING, NavigatorState.ON_EDGE):
+        if self.state not in (NavigatorState.LEAVING, NavigatorState.ON_EDGE,
+                              NavigatorState.ARRIVING):
             raise RuntimeError(f"turn_back() needs the robot on an edge, it is {self.state.value}")
         x, y, angle = self._left
-        self._incoming = angle
-        if self.in_corridor:
-            back = wrap(self._lane.direction(self.odometry.theta) + math.pi)
+        self._incoming, self._returning = angle, True
+        odo = self.odometry
+        if self.in_corridor or self.state is NavigatorState.ARRIVING:
+            plan = []
+            if self.state is NavigatorState.ARRIVING:
+                ex, ey, heading = self._lane_end
+                toward = math.atan2(ey - odo.y, ex - odo.x)
+                plan = [(Turn(toward, self.turn_rate), None),
+                        (Drive(math.hypot(ex - odo.x, ey - odo.y), toward,
+                               self._approach_speed), None)]
+            else:
+                heading = self._lane.direction(odo.theta)
+            back = wrap(heading + math.pi)
             self._plan = deque([
+                *plan,
                 (Turn(back, self.turn_rate), None),
                 *self._shift(back, +1, 2.0 * self.conv.lane_offset_m),
                 (SeekLine(back, self.speed, self.conv.max_seek_m), self._found_lane),
             ])
             self.state = NavigatorState.LEAVING
-            return True
+            return
         # to the outer end of the spoke it left by, then in along it as on any arrival
-        odo, out = self.odometry, self.conv.spoke_radius_m + self.cal.line_ahead_m
+        out = self.conv.spoke_radius_m + self.cal.line_ahead_m
         px, py = x + out * math.cos(angle), y + out * math.sin(angle)
         toward, inward = math.atan2(py - odo.y, px - odo.x), wrap(angle + math.pi)
         self._plan = deque([
@@ -199,7 +215,6 @@ class Navigator:
             (FollowSpoke(self._approach_speed), self._spoke_ended),
         ])
         self.state = NavigatorState.ARRIVING
-        return True
 
     def update(self, percept: Percept) -> tuple[float, float]:
         """Advance one control tick; return the ``(v, omega)`` command (m/s, rad/s)."""
@@ -235,6 +250,17 @@ class Navigator:
         return self.state is NavigatorState.ON_EDGE and self._wall_seen
 
     @property
+    def room_to_turn(self) -> bool:
+        """Far enough into its corridor for a U-turn (:meth:`turn_back`) to keep clear of
+        the vertex area behind: the U-turn's sidestep carries it
+        ``2 lane_offset_m / tan(60 deg)`` back, and it is at least ``min_wall_run_m`` more
+        past where its wall began (a vertex area ends where its walls begin)."""
+        if not self.in_corridor:
+            return False
+        back_m = 2.0 * self.conv.lane_offset_m / math.tan(SHIFT_ANGLE)
+        return self.odometry.distance_m - self._wall_first_m >= back_m + self.conv.min_wall_run_m
+
+    @property
     def on_lane(self) -> bool:
         """Following an edge's lane (not yet arriving at the vertex at its end)."""
         return self.state is NavigatorState.ON_EDGE
@@ -266,6 +292,7 @@ class Navigator:
         self.vertex_detected = False
         self._wall_seen = False
         self._wall_run_start = None
+        self._wall_first_m = None
         self._lane = FollowLine(self.speed)
         self._plan = deque([(self._lane, self._lane_ended)])
 
@@ -279,7 +306,12 @@ class Navigator:
         if abs(percept.ir[0] - self.conv.wall_distance_m) <= self.conv.wall_tolerance_m:
             if self._wall_run_start is None:
                 self._wall_run_start = travelled
-            if travelled - self._wall_run_start >= self.conv.min_wall_run_m:
+            if self._wall_first_m is None:
+                self._wall_first_m = travelled
+            # a robot that turned back may have little wall left beside it (a U-turn at
+            # the far end of a short edge): any of it will do
+            run = 0.0 if self._returning else self.conv.min_wall_run_m
+            if travelled - self._wall_run_start >= run:
                 self._wall_seen = True
         else:
             self._wall_run_start = None
@@ -288,11 +320,12 @@ class Navigator:
                 self.events.append(NavigatorEvent(NavEvent.VERTEX_DETECTED))
 
     def _lane_ended(self, lane: FollowLine) -> None:
-        if not self.vertex_detected:
+        if not self.vertex_detected and not self._returning:
             self._lose("lane ended with the wall still beside the robot")
             return
         self.state = NavigatorState.ARRIVING
         heading = lane.direction(self.odometry.theta, last=None)
+        self._lane_end = (self.odometry.x, self.odometry.y, heading)
         # the lane's direction in the odometry frame, carried to the scan: the incoming
         # spoke lies opposite it (a better reference than the angle measured at the last
         # vertex, which carries that scan's error)
@@ -340,6 +373,7 @@ class Navigator:
             self.edge_angles = off_centre_correction(
                 angles, self.arrived_angle, self.cal.line_ahead_m)
         self.state = NavigatorState.AT_VERTEX
+        self._returning = False
         self.events.append(NavigatorEvent(NavEvent.ARRIVED))
 
     def _lose(self, why: str) -> None:

@@ -142,8 +142,8 @@ def register(subparsers) -> None:
                              "keeps a radio route to the base at the root; biconnected: two "
                              "disjoint routes, so that one robot failing cuts nobody off. "
                              "Needs --radio-range. A team that cannot go on says so "
-                             "(infeasible) and stops. Relays on demand: graph world only "
-                             "so far")
+                             "(infeasible) and stops. Robots stuck at the end of their "
+                             "leash call relays, in both worlds")
     parser.add_argument("--radio-range", type=float, default=None, metavar="M",
                         help="radio range, m. Graph world: robots and a base at the root "
                              "talk within it (walls ignored), and the result reports "

@@ -40,8 +40,10 @@ injects faults, measures and records. Choices it makes, beyond the paper:
   the root joins the robots' radio (links need line of sight, as between robots); every
   robot keeps its tether (:mod:`algorithms.exploration.tether`) from a radio-ranging
   sensor (range and bearing of its radio neighbours); the base adopts, beats and floods
-  on. Relays on demand (rule 6) run in the graph world only so far. Ground truth every
-  tick: networkx on the radio graph with the base (``cut_ticks``, ``fragile_ticks``).
+  on; relays on demand (rule 6) walk back along edges by turning on their lane, and the
+  stations let a relay onto its requester's lane (:mod:`algorithms.exploration.entry`).
+  A time unit of rules 5 and 6 is the mean edge at the run's speed plus a scan. Ground
+  truth every tick: networkx on the radio graph with the base (``cut_ticks``, ``fragile_ticks``).
   The robots' own stall verdict (rule 5) replaces the ``stall_timeout_s`` check.
   Tables (connectivity awareness) are off in these runs.
 * **Metrics**: ``makespan`` is the largest number of edges any robot had traversed when
@@ -74,7 +76,9 @@ from algorithms.exploration.entry import (
     EntryRequest,
     Halted,
     LeftVertex,
+    TurnedBack,
     VertexClear,
+    Withdraw,
 )
 from algorithms.exploration.explorer import Explorer, VertexCall
 from algorithms.exploration.relay import Flooder
@@ -213,6 +217,8 @@ class EmbodiedResult(ExplorationResult):
     #: whether the robots declared the exploration infeasible (rule 5 of the tether)
     infeasible: bool = False
     reason: str | None = None
+    #: relay missions the robots set out on (rule 6 of :mod:`algorithms.exploration.relay`)
+    relay_trips: int = 0
 
 
 def same_lane_bearing(range_m: float) -> float:
@@ -301,6 +307,10 @@ class EmbodiedExploration(LoopFunctions):
         #: each robot's vertex: the one it stands on or was granted; the one it is leaving
         self.target: list[str | None] = [None] * k
         self.leaving: list[str | None] = [None] * k
+        #: the vertex each robot last asked to leave (where a walk back takes it), and
+        #: the angle it asked for
+        self.came_from: list[str | None] = [None] * k
+        self.asked: list[float | None] = [None] * k
         #: robots granted a vertex whose previous holder has not yet left it
         self.awaiting_clear: set[int] = set()
         self.paths = [[spec.root] for _ in range(k)]
@@ -427,7 +437,7 @@ class EmbodiedExploration(LoopFunctions):
                 clear = not any(v == vertex for j, v in enumerate(self.leaving) if j != i)
                 if not clear:
                     self.awaiting_clear.add(i)
-                self.uplink.reply(i, EntryGranted(clear=clear))
+                self.uplink.reply(i, EntryGranted(clear, self.asked[i]))
                 self._event(i, f"R{i + 1} granted {vertex}")
 
     def after_act(self, loop: Loop, i: int) -> None:
@@ -496,13 +506,56 @@ class EmbodiedExploration(LoopFunctions):
                     f"its departure angle at {vertex} is {math.degrees(off):.0f} deg from "
                     "every edge there"))
                 return
+            self.came_from[i], self.asked[i] = vertex, payload.angle_rad
+            if payload.part_way:  # a relay's last leg: onto the lane, not into ``ahead``
+                self.leaving[i], self.target[i] = vertex, None
+                self.uplink.reply(i, EntryGranted(False, payload.angle_rad))
+                return
             self.stations.request(i, vertex, ahead, self.sim.time_s)
+        elif isinstance(payload, TurnedBack):
+            self._turned_back(i, payload.from_lane)
+        elif isinstance(payload, Withdraw):
+            self._withdraw(i)
+
         elif isinstance(payload, LeftVertex):
             left, self.leaving[i] = self.leaving[i], None
             self.stations.release(i, left)
             self._tell_clear()
         elif isinstance(payload, Halted):
             self._release(i)
+
+    def _withdraw(self, i: int) -> None:
+        """Robot ``i``, still on its vertex centre, drops its request or gives its grant
+        back (:mod:`algorithms.exploration.entry`, step 5). If its vertex went to another
+        robot in a swap, that robot still waits until this one has left the area."""
+        self.stations.withdraw(i)
+        here = self.leaving[i]
+        if here is None:
+            return  # not granted yet
+        self.stations.release(i, self.target[i])
+        self.awaiting_clear.discard(i)
+        self.target[i] = here
+        if self.stations.holder.get(here) == i:
+            self.leaving[i] = None
+        self._tell_clear()
+
+    def _turned_back(self, i: int, from_lane: bool) -> None:
+        """Robot ``i`` walks back along its edge (:mod:`algorithms.exploration.entry`, step
+        5): short of its corridor it gets the vertex behind back at once, unless the
+        station gave it to another robot (a swap: no answer, and it goes on); else it asks
+        for it as from a centre, and the grant tells it when it may turn, or enter."""
+        back = self.came_from[i]
+        if not from_lane and self.leaving[i] == back and self.stations.holder.get(back) != i:
+            return
+        self.awaiting_clear.discard(i)
+        self.stations.release(i, self.target[i])
+        if self.leaving[i] == back:  # it had not left that area: it is its own again
+            self.leaving[i], self.target[i] = None, back
+            self.uplink.reply(i, EntryGranted(clear=True))
+        else:  # from its lane, or its corridor: as a request from a centre
+            self.target[i], self.asked[i] = None, None  # the grant answers no EntryRequest
+            self.stations.request(i, None, back, self.sim.time_s)
+        self._tell_clear()
 
     def _release(self, i: int) -> None:
         """Robot ``i`` stopped for good: its holds go; a station whose vertex area the
@@ -642,13 +695,15 @@ class EmbodiedExploration(LoopFunctions):
         return self._vertex_ids[self._nearest[i]], float(self._nearest_m[i])
 
     def _tether(self, i: int, first: int) -> Tether:
-        """Robot ``i``'s tether: a time unit is the mean edge at the run's speed (rule 5's
-        patience counts in them)."""
+        """Robot ``i``'s tether: a time unit (rules 5 and 6 count in them) is what the
+        graph world's edge stands for, the mean edge at the run's speed and the scan at
+        the vertex it leads to (one full turn)."""
         need = NEED[self.config.connectivity]
-        spec = self.spec
+        spec, cfg = self.spec, self.config
         mean_m = float(np.mean([math.dist(spec.vertices[u], spec.vertices[v])
                                 for u, v in spec.edges]))
-        ticks = max(1, round(mean_m / self.config.speed_m_s / self.sim.control_dt_s))
+        unit_s = mean_m / cfg.speed_m_s + 2.0 * math.pi / cfg.turn_rate_rad_s
+        ticks = max(1, round(unit_s / self.sim.control_dt_s))
         return Tether(i, self.config.radio_range_m, *initial_parents(i, need, first),
                       margin_m=TETHER_MARGIN_M, ticks_per_unit=ticks)
 
@@ -687,6 +742,7 @@ class EmbodiedExploration(LoopFunctions):
             biconnected_share=(1.0 - self.fragile_ticks / self.tied_ticks) if self.tied_ticks
             else None,
             infeasible=any(r.infeasible for r in self.robots),
+            relay_trips=sum(r.connected.relay_trips for r in self.robots if r.connected),
             reason=self._infeasible_reason() if any(r.infeasible for r in self.robots) else None,
             ended_because=self.ended_because,
             stopped_robots=list(self.stopped),

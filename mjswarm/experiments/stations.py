@@ -30,6 +30,12 @@ stopped by the speed rule just after leaving (still holding its vertex) behind a
 waiting on the lane for a vertex whose holder was stopped the same way closed a cycle
 (issue 13: four robots on one edge of ``lattice:10x10``).
 
+**Robots that turn back** (rule 6's relays, ours) ask for the vertex behind them from a
+lane (``at`` None) and wait where that lane's wall ends. Such a robot holds nothing (it
+gave up the vertex ahead when it turned, and the one behind when it reached its
+corridor), so nobody waits on it and no chain of waits closes through it; the chains
+above are unchanged.
+
 Grants go in the order of the requests (then robot index), so a waiting robot is served
 before later ones. Ground truth used here, as the paper's station had it: the arena's
 edges at each vertex (:func:`mjswarm.arena.geometry.vertex_fans`).
@@ -46,9 +52,10 @@ from mjswarm.arena.geometry import vertex_fans
 
 @dataclass(frozen=True)
 class Request:
-    """Robot waiting on the centre of ``at`` to leave towards ``to`` (requested at ``since_s``)."""
+    """Robot waiting on the centre of ``at`` (None: on a lane, turned back) to go to ``to``
+    (requested at ``since_s``)."""
 
-    at: str
+    at: str | None
     to: str
     since_s: float
 
@@ -72,9 +79,13 @@ class VertexStations:
         """``robot`` was put on ``vertex`` (a launch): it holds it."""
         self.holder[vertex] = robot
 
-    def request(self, robot: int, at: str, to: str, now_s: float) -> None:
-        """``robot``, on the centre of ``at``, wants to leave towards ``to``."""
+    def request(self, robot: int, at: str | None, to: str, now_s: float) -> None:
+        """``robot``, on the centre of ``at`` (None: on a lane), wants to go to ``to``."""
         self.requests[robot] = Request(at, to, now_s)
+
+    def withdraw(self, robot: int) -> None:
+        """``robot`` no longer asks (no effect once granted)."""
+        self.requests.pop(robot, None)
 
     def grant(self) -> list[tuple[int, str]]:
         """Grant what can be granted now; returns ``(robot, vertex)`` pairs, in order."""
