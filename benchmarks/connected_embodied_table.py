@@ -1,0 +1,73 @@
+"""Issue 17's embodied table: exploration that stays connected on the MuJoCo robots.
+
+Each case (arena, team size K, radio range R in m, speed in m/s, seed) is one
+``connected`` run of :func:`mjswarm.experiments.exploration.explore_embodied`
+(incidence-DFS, tie-breaking randomised by the seed), two at a time; prints a markdown
+table: the outcome (makespan in edges and total traversals, or the verdict with the
+explored share), robot-robot contact events, ticks in which some robot had no radio route
+to the base (ground truth, walls block links), relay trips (rule 6), robots stopped for
+good, simulated and wall seconds. Cases are small so that one table takes minutes.
+
+    python benchmarks/connected_embodied_table.py [--jobs 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+if __package__ in (None, ""):  # run as a script: make the repository importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+#: (arena, K, R (m), speed (m/s), seed)
+CASES = [
+    ("arena1", 2, 1.5, 0.1, 0),
+    ("arena1", 3, 1.5, 0.1, 2),
+    ("arena1", 3, 2.5, 0.1, 5),
+    ("arena2", 4, 1.5, 0.1, 1),
+    ("arena2", 4, 2.0, 0.1, 0),
+    ("arena2", 6, 1.5, 0.1, 3),
+    ("fig9", 3, 1.2, 0.1, 0),
+    ("lattice:2x3:0.8", 3, 1.2, 0.1, 0),
+    ("lattice:2x3:0.8", 4, 1.5, 0.1, 1),
+    ("lattice:1x5:0.75", 3, 1.2, 0.1, 0),
+]
+
+
+def run_case(case: tuple) -> str:
+    """One table row."""
+    from mjswarm.arena import load_arena
+    from mjswarm.experiments.exploration import EmbodiedConfig, explore_embodied
+
+    arena, k, range_m, speed, seed = case
+    start = time.perf_counter()
+    r = explore_embodied(load_arena(arena), k, seed=seed, config=EmbodiedConfig(
+        speed_m_s=speed, radio_range_m=range_m, connectivity="connected"))
+    wall = time.perf_counter() - start
+    if r.completed:
+        outcome = f"completed, {r.makespan} / {r.total_traversals}"
+    elif r.infeasible:
+        outcome = "infeasible: " + r.reason.split(": ")[1]
+    else:
+        outcome = r.ended_because
+    return (f"| `{arena}` | {k} | {range_m:g} | {speed:g} | {seed} | {outcome} | {r.collisions} | "
+            f"{r.cut_ticks} | {r.relay_trips} | {len(r.stopped_robots)} | "
+            f"{r.sim_time_s:.0f} / {wall:.0f} |")
+
+
+def table(cases: list[tuple], jobs: int) -> list[str]:
+    head = ["| arena | K | R (m) | speed (m/s) | seed | outcome | contacts | cut ticks "
+            "| relay trips | stopped | sim / wall (s) |",
+            "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|"]
+    with ProcessPoolExecutor(jobs) as pool:
+        return head + list(pool.map(run_case, cases))
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--jobs", type=int, default=2, help="runs at a time (default 2)")
+    args = parser.parse_args()
+    print("\n".join(table(CASES, args.jobs)))
