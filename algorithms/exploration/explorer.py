@@ -173,15 +173,7 @@ class Explorer(Controller):
         if self.tether is not None:
             around = {j: (d.range_m * math.cos(d.bearing_rad), d.range_m * math.sin(d.bearing_rad))
                       for j, d in observation.detections.items()}
-            tied = [m for m in observation.inbox if m.sender != STATION]
-            # leaving a vertex (granted the next one) it adopts nobody: it would hold both
-            out += self.connected.hear(now, tied, around, willing=not self._leaving)
-        if self._withdrawn and not self.tether.children:
-            self._withdrawn = False  # free to go: ask again
-            out.append(Message(self._asked, STATION))
-        if self.tether is not None and self.connected.relay_trips != self._trips:
-            self._trips = self.connected.relay_trips
-            self._set_out(observation.time_s, out)
+            self._hear(now, observation, around, out)
         if self.halted is not None or self.declared or self.infeasible:
             if self.connected is not None:
                 self.connected.retire()  # it serves as nobody's relay
@@ -191,6 +183,23 @@ class Explorer(Controller):
         command = self._drive(observation, out)
         if self.tether is None:
             return command
+        return self._leash(now, command, around)
+
+    def _hear(self, now: int, observation: Observation, around, out: list[Message]) -> None:
+        """Its connected exploration reads the radio; what rule 6 asks of vertex entry."""
+        tied = [m for m in observation.inbox if m.sender != STATION]
+        # leaving a vertex (granted the next one) it adopts nobody: it would hold both
+        out += self.connected.hear(now, tied, around, willing=not self._leaving)
+        if self._withdrawn and not self.tether.children:
+            self._withdrawn = False  # free to go: ask again
+            out.append(Message(self._asked, STATION))
+        if self.connected.relay_trips != self._trips:
+            self._trips = self.connected.relay_trips
+            self._set_out(observation.time_s, out)
+
+    def _leash(self, now: int, command: Command, around) -> Command:
+        """Rules 3-6 on this tick's command: it stands where the leash (or a wall it met
+        on this leg) forbids its drive, then asks, beats, and judges the stall."""
         wanted = None
         if command.v_m_s != 0.0:
             step = (command.v_m_s * self.control_dt_s, 0.0)  # in its own frame
