@@ -249,6 +249,7 @@ def test_cli_reports_the_constraint(tmp_path, capsys):
 @pytest.mark.parametrize("argv,message", [
     (["--connectivity", "connected", "--world", "graph"], "needs --radio-range"),
     (["--radio-range", "-1", "--world", "graph"], "radio range must be positive"),
+    (["--radio-range", "3", "--connectivity", "biconnected"], "runs in the graph world only"),
 ])
 def test_cli_bad_input_is_one_line(capsys, argv, message):
     assert main(["explore", "--arena", "fig9", "--robots", "2", *argv]) == 2

@@ -140,7 +140,8 @@ def register(subparsers) -> None:
     parser.add_argument("--connectivity", default=None, choices=CONNECTIVITY,
                         help="none: explore as seed 003 (default); connected: every robot "
                              "keeps a radio route to the base at the root; biconnected: two "
-                             "disjoint routes, so that one robot failing cuts nobody off. "
+                             "disjoint routes, so that one robot failing cuts nobody off "
+                             "(graph world only). "
                              "Needs --radio-range. A team that cannot go on says so "
                              "(infeasible) and stops. Robots stuck at the end of their "
                              "leash call relays, in both worlds")

@@ -150,9 +150,10 @@ class EmbodiedConfig:
         wheel_slip: scale of the wheel-slip model (:class:`mjswarm.core.simulation.Simulation`).
         physics: ``"dynamic"`` (MuJoCo's contact physics) or ``"kinematic"`` (the fast
             tier, :mod:`mjswarm.core.kinematic`).
-        connectivity: ``"none"``, or ``"connected"`` / ``"biconnected"`` (needs
-            ``radio_range_m``): every robot keeps its tether to a base station at the root
+        connectivity: ``"none"``, or ``"connected"`` (needs ``radio_range_m``): every
+            robot keeps its tether to a base station at the root
             (:mod:`algorithms.exploration.tether`; see the module docstring).
+            ``"biconnected"`` is refused: it runs in the graph world only (README).
     """
 
     speed_m_s: float = PAPER_SPEED_M_S
@@ -257,6 +258,10 @@ class EmbodiedExploration(LoopFunctions):
         tied = config.connectivity != "none"
         if tied and config.radio_range_m is None:
             raise MjswarmError(f"connectivity {config.connectivity} needs a radio range")
+        if config.connectivity == "biconnected":  # a false verdict would mislead: refuse
+            raise MjswarmError(
+                "connectivity biconnected runs in the graph world only (--world graph): on "
+                "bodies the robot rule 1 pins for good stands in vertex areas the others need")
         self.spec, self.minds, self.config, self.seed = spec, minds, config, seed
         self.recorder = recorder
         xs = [x for x, _ in spec.vertices.values()]
