@@ -4,22 +4,23 @@ The tether keeps every robot connected, but a robot that reaches the end of its 
 only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
 
 * **Request.** An exploring robot (or one walking back to its task) that has wanted to
-  step and could not for ``RECRUIT_AFTER_UNITS`` floods ``RelayWanted`` with where it is: its loop-free route
-  from the root (the legs it took, each named by the beacon it started from and the
-  incidence angles at both ends), the leg it is on, and how far along it is.
+  step and could not for ``RECRUIT_AFTER_UNITS`` floods ``RelayWanted`` with where it is:
+  its loop-free route from the root (the legs it took, each named by the beacon it
+  started from and the incidence angles at both ends), the leg it is on, and how far
+  along it is.
 * **Offer.** A robot that is free (exploring, without children, and itself stuck or held
   by the world as long, or idle at a vertex) floods ``RelayOffer``. (A robot held on a
-  vertex centre with its request for the next vertex open sets off on that grant when it
-  comes, and walks back at once, as a relay that is on its way anywhere does.) A robot with a request of its own offers only
-  to requesters with a smaller index, and then drops its request, so one of two stuck
-  robots always serves the other.
+  vertex centre before its leg began is back where it started at once: the world calls
+  :meth:`ConnectedExplorer.arrived_back` without moving it.) A robot with a request of
+  its own offers only to requesters with a smaller index, and then drops its request, so
+  one of two stuck robots always serves the other.
 * **Accept.** The requester takes the first offer (the lowest index among those of one
   tick) and floods ``RelayAccepted``; other offers lapse after ``OFFER_TIMEOUT_UNITS``.
 * **Transit.** The relay suspends its own task (its strategy is not asked anything and no
   beacon is written until it resumes), goes back to the last vertex where its route and the
   requester's agree, then along the requester's route and leg, and stops where the
-  requester is (or where its own leash stops it). There it stands still: rule 4 lets the
-  requester adopt it, and the requester goes on within range of its relay.
+  requester is, less the world's ``spacing`` (or where its own leash stops it). There it
+  stands still: rule 4 lets the requester adopt it, and the requester goes on within range of its relay.
 * **Release.** A relay holds while it has children. Once it has had none for
   ``RELEASE_UNITS`` (its child went on, or came back and re-attached nearer the base), or
   was never adopted within ``RELAY_PATIENCE_UNITS``, it goes back the same way and resumes
@@ -45,7 +46,8 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
 The walk is the robot's own: it follows incidence angles from vertex to vertex as seed
 003's robots do; routes name vertices by their beacons (each beacon's hardware identity).
 Walking back along an edge is the world's: the graph world reverses, a MuJoCo robot turns
-onto the opposite lane (:meth:`~algorithms.navigation.Navigator.turn_back`). The waits are in time units, so they keep their meaning at any control rate.
+onto the opposite lane (:meth:`~algorithms.navigation.Navigator.turn_back`). The waits are
+in time units, so they keep their meaning at any control rate.
 Flooded messages are forwarded once by every robot and by the base.
 """
 
@@ -397,9 +399,9 @@ class ConnectedExplorer:
 
     def _settled(self) -> bool:
         """Whether it stands by its own choice (a relay, in reserve, idle, holding, stuck
-        at the end of its leash, or held by the world): only then does its beat say it is still, so that nobody
-        asks a robot that merely paused between two moves to adopt them (it would hold
-        there for as long as its child needs it)."""
+        at the end of its leash, or held by the world): only then does its beat say it is
+        still, so that nobody asks a robot that merely paused between two moves to adopt
+        them (it would hold there for as long as its child needs it)."""
         return (self.mode in (RELAY, RESERVE) or self.idle or self.stuck > 0
                 or self.held > 0 or bool(self.tether.children))
 

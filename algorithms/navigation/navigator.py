@@ -140,7 +140,8 @@ class Navigator:
         self._tracks: list[float] = []  # effective track estimates, one per scan (m)
         self._lane: FollowLine | None = None
         self._left: tuple[float, float, float] | None = None  # centre x, y and angle it left by
-        self._lane_end: tuple[float, float, float] | None = None  # x, y, heading where its lane ended
+        #: x, y and heading (odometry) where its lane ended
+        self._lane_end: tuple[float, float, float] | None = None
         self._returning = False  # turned back: on its way to the vertex it left
         self._wall_run_start: float | None = None
         self._wall_seen = False
