@@ -276,8 +276,11 @@ class Explorer(Controller):
             if self._tell_turn and nav.on_lane:  # out of the area ahead, on its way back
                 out.append(Message(TurnedBack(from_lane=True), STATION))
                 self._tell_turn, self._trail = False, []
-            if nav.at_vertex_area and not self._clear:
-                speed = 0.0  # the previous holder of the vertex ahead is still leaving it
+            # waiting for the vertex ahead (its previous holder is still leaving it), at
+            # the wall's end; one that turned back waits as soon as it follows its new
+            # lane, which may carry a robot arriving at that vertex ahead of it
+            if not self._clear and (nav.at_vertex_area or (self._turning and nav.on_lane)):
+                speed = 0.0
         self.speed_m_s = speed
         # held: the speed rule or vertex entry stops it, or it waits for its grant
         self._held = (v != 0.0 and speed == 0.0) or self._departure is not None

@@ -20,7 +20,8 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   beacon is written until it resumes), goes back to the last vertex where its route and the
   requester's agree, then along the requester's route and leg, and stops where the
   requester is, less the world's ``spacing`` (or where its own leash stops it). There it
-  stands still: rule 4 lets the requester adopt it, and the requester goes on within range of its relay.
+  stands still: rule 4 lets the requester adopt it, and the requester goes on within
+  range of its relay.
 * **Release.** A relay holds while it has children. Once it has had none for
   ``RELEASE_UNITS`` (its child went on, or came back and re-attached nearer the base), or
   was never adopted within ``RELAY_PATIENCE_UNITS``, it goes back the same way and resumes
@@ -37,7 +38,8 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   necessity, for as long as what holds it lasts, so it counts as settled (below).
 
 * **Settled robots adopt.** A robot's beat says it stands still only when it stands by
-  its own choice: a relay, in reserve, idle, holding, or stuck at the end of its leash.
+  its own choice or by necessity: a relay, in reserve, idle, holding, stuck at the end
+  of its leash, or held by the world.
   Rule 4 asks only robots whose beat says so, so a robot that merely paused between two
   moves (at a vertex on its way back to its task, say) is never made a permanent anchor
   wherever it happened to be (on ``lattice:1x8`` with five robots at 1 m, a robot

@@ -172,13 +172,12 @@ class Navigator:
         offsets to the left, find the lane), then on as along any edge: the vertex is
         where the new left wall ends (however little of it it saw: after a U-turn at the
         far end of a short edge a few centimetres may be left; where its lane ends, if
-        it saw none), and the arrival is by the edge it left along.
-        Arriving at the vertex ahead (its lane ended): back by odometry to where the lane
-        ended, then the same U-turn. Short
-        of its corridor (leaving, or on the lane before its wall): by odometry to the outer
-        end of the spoke it left by, then in along the spoke to the centre and a scan, as
-        on any arrival, by the edge it left along. Both
-        are ours (seed 003's robots never turned back)."""
+        it saw none), and the arrival is by the edge it left along. Arriving at the
+        vertex ahead (its lane ended): back by odometry to where the lane ended, then the
+        same U-turn. Short of its corridor (leaving, or on the lane before its wall): by
+        odometry to the outer end of the spoke it left by, then in along the spoke to the
+        centre and a scan, as on any arrival, by the edge it left along. All ours (seed
+        003's robots never turned back)."""
         if self.state not in (NavigatorState.LEAVING, NavigatorState.ON_EDGE,
                               NavigatorState.ARRIVING):
             raise RuntimeError(f"turn_back() needs the robot on an edge, it is {self.state.value}")

@@ -33,8 +33,13 @@ waiting on the lane for a vertex whose holder was stopped the same way closed a 
 **Robots that turn back** (rule 6's relays, ours) ask for the vertex behind them from a
 lane (``at`` None) and wait where that lane's wall ends. Such a robot holds nothing (it
 gave up the vertex ahead when it turned, and the one behind when it reached its
-corridor), so nobody waits on it and no chain of waits closes through it; the chains
-above are unchanged.
+corridor), so no chain of station waits closes through it; the chains above are
+unchanged. One wait is not the stations': a robot that asked from its corridor, not yet
+turned (too near the vertex behind for a U-turn), still stands on the lane that leads
+away from that vertex, and a robot leaving that vertex along the same edge is stopped
+behind it by the speed rule while it holds the vertex the first one waits for. That
+deadlock is not broken here; the team's stall verdict ends such a run (seen once, on
+``arena2`` with 4 robots at 2 m, while rule 6 was being built).
 
 Grants go in the order of the requests (then robot index), so a waiting robot is served
 before later ones. Ground truth used here, as the paper's station had it: the arena's
