@@ -8,8 +8,9 @@ import json
 import pytest
 
 from algorithms.exploration.tether import (BASE, STALL_TIME_UNITS, STALL_UNITS_PER_EDGE,
-                                           Adopt, Adopted, Beat, Tether)
-from algorithms.exploration.relay import (RELAY, RETURN, TRANSIT, ConnectedExplorer,
+                                           Adopt, Adopted, Beat, Tether, docked,
+                                           initial_parents)
+from algorithms.exploration.relay import (RELAY, RETURN, TRANSIT, ConnectedExplorer, Flooder,
                                           RelayOffer, RelayWanted, Waits)
 from algorithms.robot import Message
 from mjswarm.arena import load_arena
@@ -213,6 +214,39 @@ def test_a_biconnected_robot_needs_both_parents_within_the_leash():
     assert not t.may_step((0.0, -0.2), {BASE: (-0.5, 0.0), 0: (0.0, 0.9)})  # robot 0 too far
 
 
+def test_the_first_robot_of_a_biconnected_team_docks_at_the_base():
+    """Rule 1: every other robot starts with the base and the first robot as parents; the
+    first keeps no tether of its own and answers as a still robot one hop from the base."""
+    assert initial_parents(2, 1) == (BASE,)
+    assert initial_parents(2, 2, first=1) == (BASE, 1)
+    with pytest.raises(ValueError, match="docks at the base"):
+        initial_parents(1, 2, first=1)
+    dock = docked(Flooder())
+    out = dock.step([Message(Adopt(), to=0, sender=3),
+                     Message(Beat((BASE, 0), 2, False, 40, 7), sender=3)])
+    assert out[0] == Message(Adopted(1), to=3)
+    assert out[-1].payload == Beat((BASE,), 1, True, 40, 7)  # still, one hop, gossip on
+
+
+def test_a_parent_that_allows_the_step_is_never_traded_for_one_that_forbids_it():
+    """Rule 4 with two parents: robot 1 has replaced the base by robot 2 and still waits
+    for robot 0 (docked at the base) to be replaced. The base is nearer the root than
+    robot 2 but forbids the step: asking it to stand in for robot 2 would undo the last
+    replacement, and the robot would swap the two for ever."""
+    heard = [Message(Beat((), 0, True, 0, 0), sender=BASE),
+             Message(Beat((BASE,), 1, True, 0, 0), sender=0),
+             Message(Beat((BASE, 0), 2, True, 0, 0), sender=2)]
+    around = {BASE: (-0.95, 0.0), 0: (-0.95, 0.0), 2: (0.3, 0.0)}
+    t = Tether(1, range_m=1.0, parents=(2, 0))
+    t.hear(1, heard, around)
+    step = (0.1, 0.0)
+    assert not t.may_step(step, around)
+    assert t.ask(1, step, around) == []  # nobody who allows the step: it waits
+    around[3] = (0.5, 0.2)  # a still robot that allows it stands in for robot 0
+    t.hear(2, [*heard, Message(Beat((BASE, 0), 2, True, 0, 0), sender=3)], around)
+    assert t.ask(2, step, around) == [Message(Adopt(), to=3)] and t.request[2] == 0
+
+
 def test_crossing_requests_adopt_nobody():
     """Two robots asking each other at once both refuse: no cycle can close."""
     a, b = Tether(1, range_m=1.0), Tether(2, range_m=1.0)
@@ -249,7 +283,8 @@ def test_cli_reports_the_constraint(tmp_path, capsys):
 @pytest.mark.parametrize("argv,message", [
     (["--connectivity", "connected", "--world", "graph"], "needs --radio-range"),
     (["--radio-range", "-1", "--world", "graph"], "radio range must be positive"),
-    (["--radio-range", "3", "--connectivity", "biconnected"], "runs in the graph world only"),
+    (["--radio-range", "3", "--connectivity", "biconnected", "--robots", "1"],
+     "needs at least 2 robots"),
 ])
 def test_cli_bad_input_is_one_line(capsys, argv, message):
     assert main(["explore", "--arena", "fig9", "--robots", "2", *argv]) == 2
@@ -277,11 +312,12 @@ def test_the_readme_table_script_runs():
 
 
 # ---------------------------------------------------------------------------- embodied
-def embodied(arena: str, robots: int, range_m: float, seed: int | None = None, **config):
+def embodied(arena: str, robots: int, range_m: float, seed: int | None = None,
+             connectivity: str = "connected", **config):
     from mjswarm.experiments.exploration import EmbodiedConfig, explore_embodied
 
     return explore_embodied(load_arena(arena), robots, config=EmbodiedConfig(
-        radio_range_m=range_m, connectivity="connected", **config), seed=seed)
+        radio_range_m=range_m, connectivity=connectivity, **config), seed=seed)
 
 
 def test_embodied_with_range_to_spare_changes_nothing():
@@ -293,14 +329,27 @@ def test_embodied_with_range_to_spare_changes_nothing():
     assert result.collisions == 0 and result.cut_ticks == 0 and result.connected_share == 1.0
 
 
-def test_embodied_relays_carry_a_team_the_tether_alone_stopped():
+def test_embodied_team_completes_a_map_that_needs_a_robot_standing_between():
     """arena1, 3 robots at 2.5 m, 10 cm/s, seed 5: v8 lies 2.7 m from the base, so a robot
-    must stand between (the tether alone, before rule 6 ran on bodies, declared the team
-    infeasible with 8 of 9 edges explored). Now it completes the true map, with 0
-    contacts and every robot linked to the base in every tick."""
+    must stand between (before session 8 the team declared itself infeasible with 8 of 9
+    edges explored). It completes the true map, with 0 contacts and every robot linked
+    to the base in every tick."""
     result = embodied("arena1", 3, 2.5, seed=5, speed_m_s=0.1)
     assert result.completed and result.map_correct and not result.infeasible
     assert result.collisions == 0 and result.cut_ticks == 0 and result.connected_share == 1.0
+
+
+def test_embodied_biconnected_team_completes_with_its_first_robot_docked():
+    """arena1, 3 robots at 3 m, 10 cm/s: R1 docks at the base (rule 1), R2 and R3 explore
+    the true map with two disjoint routes to the base in every tick and 0 contacts. (Before
+    the dock, R1 stood on the first edge for good and the team declared itself
+    infeasible at 1 of 9 edges.)"""
+    result = embodied("arena1", 3, 3.0, seed=0, connectivity="biconnected", speed_m_s=0.1)
+    assert result.completed and result.map_correct and not result.infeasible
+    assert result.paths[0] == [result.root]  # docked: it never left
+    assert all(len(p) > 1 for p in result.paths[1:])
+    assert result.collisions == 0 and result.cut_ticks == 0
+    assert result.fragile_ticks == 0 and result.biconnected_share == 1.0
 
 
 @pytest.mark.slow
@@ -327,15 +376,17 @@ def test_a_wall_hides_a_robot_from_the_base_mast():
 
 
 def test_embodied_connected_runs_are_deterministic():
-    """Same seed, same trajectory: two runs of the relay case above (to completion, with
-    its relay trip) end in the same poses to the bit, at the same time, with the same
-    traversals."""
+    """Same seed, same trajectory: two runs of a relay case (lattice:1x5:0.75, 3 robots at
+    1.2 m: the first relay sets out at 65 s) end, after 120 s, in the same poses to the
+    bit, with the same traversals and relay trips."""
     from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
 
     def run_once():
-        run = EmbodiedExploration(load_arena("arena1"), make_minds("incidence-dfs", 3, 5),
-                                  EmbodiedConfig(speed_m_s=0.1, radio_range_m=2.5,
-                                                 connectivity="connected"), 5)
+        run = EmbodiedExploration(load_arena("lattice:1x5:0.75"),
+                                  make_minds("incidence-dfs", 3, 0),
+                                  EmbodiedConfig(speed_m_s=0.1, radio_range_m=1.2,
+                                                 connectivity="connected",
+                                                 max_sim_time_s=120.0), 0)
         result = run.run()
         return (run.sim.poses().copy(), result.sim_time_s, result.total_traversals,
                 result.relay_trips)

@@ -56,9 +56,11 @@ def test_ray_backend_on_a_local_two_cpu_instance(tmp_path):
         assert r["makespan"] == local[tuple(r[k] for k in CELL_KEYS)]
 
 
-def test_embodied_cell_runs():
-    record = run_cell(Cell("embodied", "arena1", 2, "incidence-dfs", 0))
+def test_embodied_cell_runs_with_a_constraint():
+    """An embodied cell of issue 17's grid: the MuJoCo robots on their tether."""
+    record = run_cell(Cell("embodied", "arena1", 2, "incidence-dfs", 0, 3.0, "connected"))
     assert record["completed"] and record["collisions"] == 0 and "sim_time_s" in record
+    assert record["connectivity"] == "connected" and record["cut_ticks"] == 0
 
 
 @pytest.mark.parametrize("argv,message", [
@@ -70,6 +72,8 @@ def test_embodied_cell_runs():
     (["--backend", "slurm"], "unknown backend"),
     (["--out", "/nonexistent/dir/r.jsonl"], "output directory does not exist"),
     (["--out", "results.txt"], "must end in .jsonl or .csv"),
+    (["--robots", "1", "--radio-ranges", "2", "--connectivity", "biconnected"],
+     "needs at least 2 robots"),
 ])
 def test_bad_sweeps_are_one_line(tmp_path, capsys, argv, message):
     args = ["sweep", "--arenas", "fig9", "--robots", "2", "--out", str(tmp_path / "r.jsonl")]

@@ -25,10 +25,14 @@ It composes, fed only by its own observation:
   way") when it wants to move and the speed rule or vertex entry stops it. The leash knows
   ranges, not walls: when a wall comes between it and a parent (the link is gone from its
   radio neighbours), it drives its moves since the link was last there backwards (never
-  back into a vertex area it has given up: the moves from before are forgotten), and then
+  back into a vertex area it has given up, nor off a vertex centre it reached: moves from
+  before are forgotten), and then
   stands as if the leash had stopped it (so it calls a relay, rule 6) until it has a new
   parent or sets out on a new leg; it may still walk back along its leg (rule 6), unless a
-  wall cut a link on the way back too (ours).
+  wall cut a link on the way back too (ours). A step of a walk back may use the tether's
+  reserve (rule 3: a U-turn sidesteps across its edge, and a robot at the end of its
+  leash must still be able to turn), and one that turns back in the area of the vertex
+  it arrived at backs out of it at once (that area is its own).
 
 Choices beyond the paper (the loop functions in :mod:`mjswarm.experiments.exploration` say the rest):
 
@@ -203,10 +207,13 @@ class Explorer(Controller):
         wanted = None
         if command.v_m_s != 0.0:
             step = (command.v_m_s * self.control_dt_s, 0.0)  # in its own frame
-            if self._way in self._occluded or not self.tether.may_step(step, around):
+            if self._way in self._occluded or not self.tether.may_step(step, around,
+                                                                       back=self._turning):
                 wanted, command = step, Command(messages=command.messages)
             else:
                 self._trail.append((command.v_m_s, command.omega_rad_s))
+        if self.nav.state in (NavigatorState.SCANNING, NavigatorState.AT_VERTEX):
+            self._trail = []  # on a centre, where its beacon is: no backing out of it
         if self.tether.parents != self._parents_then:  # a new parent: try again
             self._occluded, self._trail, self._cut = set(), [], set()
         self._parents_then = self.tether.parents
@@ -236,7 +243,9 @@ class Explorer(Controller):
     def _retrace(self, now: int, out: list[Message], around) -> Command:
         """A parent's link is gone (a wall came between them: the leash knows ranges, not
         walls): drive its last moves backwards until the link is back, then wait for a new
-        parent as if the leash had stopped it."""
+        parent as if the leash had stopped it (on a vertex centre, at once: a robot backed
+        out of the centre it scans on would scan off it, find no beacon and stop, as one
+        did on ``arena2`` before session 9)."""
         self._occluded.add(self._way)
         self._cut |= {q for q in self.tether.parents if q not in around}
         if not self._trail:
@@ -278,8 +287,9 @@ class Explorer(Controller):
                 self._tell_turn, self._trail = False, []
             # waiting for the vertex ahead (its previous holder is still leaving it), at
             # the wall's end; one that turned back waits as soon as it follows its new
-            # lane, which may carry a robot arriving at that vertex ahead of it
-            if not self._clear and (nav.at_vertex_area or (self._turning and nav.on_lane)):
+            # lane, which may carry a robot arriving at that vertex ahead of it (one that
+            # turns back in the area it arrived at backs out of it: that area is its own)
+            if not self._clear and (nav.on_lane if self._turning else nav.at_vertex_area):
                 speed = 0.0
         self.speed_m_s = speed
         # held: the speed rule or vertex entry stops it, or it waits for its grant

@@ -185,6 +185,7 @@ class ConnectedExplorer:
         self.request: tuple[int, int] | None = None  # (serial, tick) of an open request
         self.offer: tuple[Hashable, int, int] | None = None  # (requester, serial, tick)
         self.plan: list[tuple] = []
+        self._goal: tuple = ((), None, 0.0)  # what ``plan`` leads to (:meth:`_head_for`)
         self.stop_at: float | None = None
         self.task: tuple[tuple[Leg, ...], Leg | None, float] | None = None
         self.relay_since = 0
@@ -258,7 +259,7 @@ class ConnectedExplorer:
         w = self._wanted
         if self.task is None:  # exploring: suspend the task (else it is suspended already)
             self.task = (tuple(self.route), self.leg, self.progress)
-        self.plan = self._way(w.route, w.leg, max(0.0, w.progress - self.spacing))
+        self._head_for(w.route, w.leg, max(0.0, w.progress - self.spacing))
         self.mode, self.stuck, self.idle, self.stop_at = TRANSIT, 0, False, None
         self.relay_trips += 1
 
@@ -270,6 +271,8 @@ class ConnectedExplorer:
 
     def on_vertex(self, beacon, angles: Sequence[float], arrived_by: float | None) -> Decision:
         self.idle = self.consulted = False
+        if self.plan and self.plan[0] == ("back",):  # planned on the edge it has finished
+            self.plan = self._way(*self._goal)
         if self.mode in (TRANSIT, RETURN, RETREAT) and not self.plan:
             if self.mode == TRANSIT:  # the requester stood at a vertex
                 return self._become_relay_here()
@@ -344,6 +347,13 @@ class ConnectedExplorer:
         if self.plan and self.plan[0] == ("back",):
             self.plan.pop(0)
 
+    def _head_for(self, route: Sequence[Leg], leg: Leg | None, progress: float) -> None:
+        """Plan the way to ``progress`` along ``leg`` at the end of ``route`` (:meth:`_way`)
+        and remember the goal: a plan made on an edge the robot has in fact just finished
+        (the world tells it of the vertex after its messages) is made anew there."""
+        self._goal = (route, leg, progress)
+        self.plan = self._way(route, leg, progress)
+
     def _way(self, route: Sequence[Leg], leg: Leg | None, progress: float) -> list[tuple]:
         """The plan from here to ``progress`` along ``leg`` at the end of ``route`` (to
         the end of ``route`` if ``leg`` is None): back to the vertex it is walking from,
@@ -390,10 +400,12 @@ class ConnectedExplorer:
         if self.mode in (EXPLORE, RETURN) and self.stuck >= waits.retreat:
             if self.task is None:
                 self.task = (tuple(self.route), self.leg, self.progress)
-            self.plan, self.mode, self.request = self._way([], None, 0.0), RETREAT, None
+            self.mode, self.request = RETREAT, None
+            self._head_for([], None, 0.0)
             self.stop_at, self.stuck = None, 0
         if self.mode == RESERVE and tick - self.last_wanted >= waits.resume:
-            self.plan, self.mode = self._way(*self.task), RETURN
+            self.mode = RETURN
+            self._head_for(*self.task)
         out.append(self.tether.beat(tick, moved or not self._settled(), self.progressed,
                                     len(self.mind.map_edges())))
         self.progressed = False
@@ -416,7 +428,8 @@ class ConnectedExplorer:
                 return
         elif tick - self.had_child_at < self._waits.release:
             return
-        self.plan, self.mode = self._way(*self.task), RETURN
+        self.mode = RETURN
+        self._head_for(*self.task)
 
 
 def _common(a: Sequence[Leg], b: Sequence[Leg]) -> int:

@@ -8,20 +8,28 @@ this combination):
 
 1. **Tether.** Every robot has a *parent*: the base or a robot within radio range. The
    parent relation is a tree rooted at the base. For ``biconnected`` every robot but the
-   first has two distinct parents and the first keeps the base as its one parent, for
-   good; the parent relation is then acyclic, so ordered from the base every robot joins
-   the ones before it by two links, and a graph grown from an edge (base and first robot)
-   by vertices joined to two earlier ones is biconnected: one robot failing never cuts
-   anyone off (seed 004's two access paths). Rules 2-4 hold for every parent.
+   first has two distinct parents, and the first *docks* at the base: it keeps the base
+   as its one parent, never explores, and answers on the radio as the base does
+   (:func:`docked`). The parent relation is then acyclic, so ordered from the base every
+   robot joins the ones before it by two links, and a graph grown from an edge (base and
+   first robot) by vertices joined to two earlier ones is biconnected: one robot failing
+   never cuts anyone off (seed 004's two access paths). Rules 2-4 hold for every parent.
+   The first robot stands at the root in the graph world; a body cannot (the root's
+   area holds one robot, and every launch and every return passes through it), so on
+   the MuJoCo robots it stays off the floor, its antenna on the base's mast: the same
+   radio node as in the graph world, at the cost of one robot in both.
 2. **Holding** (seed 001's repeater role). A robot with children does not move: it relays.
    Its children are the robots whose last beat named it as parent, and those it adopted
    in the last ``ADOPT_GRACE_TICKS`` ticks (their first beat naming it is on its way).
 3. **Leash.** A robot without children takes a step only if, after the step, its parents
-   are within range ``R - margin`` of it, or no farther than before (a body may coast a
-   little past the leash; it may always come back). It knows where its radio neighbours are relative
-   to itself (a range-and-bearing sensor, as seed 001's robots have) and what its own
-   step will be. Parents hold and the base never moves, so every tree link survives every
-   tick, and nobody is ever cut off from the base.
+   are within range ``R - margin - reserve`` of it, or no farther than before (a body may
+   coast a little past the leash; it may always come back). A step of a walk back may use
+   the reserve as well (0 in the graph world; on bodies the width of a U-turn, which
+   sidesteps across the lane and may take a robot at the end of its leash farther). It
+   knows where its radio neighbours are relative to itself (a range-and-bearing sensor,
+   as seed 001's robots have) and what its own step will be. Parents hold and the base
+   never moves, so every tree link survives every tick, and nobody is ever cut off from
+   the base.
 4. **Adoption, make before break.** A robot without children whose step the leash forbids
    asks one still neighbour (or the base) that would allow the step to adopt it: the
    fewest tree hops from the base first, then the nearest. So does one that sees a still
@@ -96,18 +104,21 @@ class Tether:
         range_m: the radio range R (m).
         parents: its parents at the start (one for ``connected``; two for
             ``biconnected``, see :func:`initial_parents`); it keeps as many.
-        pinned: it never changes parents (the first robot of a biconnected team).
         margin_m: the leash keeps the parents within ``R - margin_m``.
         ticks_per_unit: control ticks per time unit (for the stall rule).
+        reserve_m: of that leash, what only a walk back may use (rule 3): a body
+            turning back on its lane sidesteps across it, and one at the end of its
+            leash must still be able to (0 for points).
     """
 
     def __init__(self, me: Hashable, range_m: float, parents: tuple = (BASE,),
-                 pinned: bool = False, margin_m: float = 0.0, ticks_per_unit: int = 10) -> None:
+                 margin_m: float = 0.0, ticks_per_unit: int = 10,
+                 reserve_m: float = 0.0) -> None:
         self.me = me
-        self.leash_m = range_m - margin_m
+        self.leash_m = range_m - margin_m - reserve_m
+        self.reserve_m = reserve_m
         self.ticks_per_unit = ticks_per_unit
         self.parents: tuple = tuple(parents)
-        self.pinned = pinned
         self.depth = 1
         self.adopted: dict[Hashable, int] = {}  # child -> tick of adoption
         self.children: set[Hashable] = set()
@@ -156,14 +167,16 @@ class Tether:
                                              if self.me in b.parents}
         return out
 
-    def may_step(self, step: Sequence[float], around: Mapping[Hashable, Sequence[float]]) -> bool:
+    def may_step(self, step: Sequence[float], around: Mapping[Hashable, Sequence[float]],
+                 back: bool = False) -> bool:
         """Rule 3: whether to take ``step`` (m, this robot's displacement) given where its
-        radio neighbours are relative to it (m). A step that brings no parent farther is
-        always allowed: a body that coasted past the leash (or read one tick old ranges)
-        may come back."""
+        radio neighbours are relative to it (m); ``back``: a step of a walk back, which
+        may use the reserve. A step that brings no parent farther is always allowed: a
+        body that coasted past the leash (or read one tick old ranges) may come back."""
         if self.children or self.request is not None:
             return False
-        return all(self._within(step, around.get(q)) or _nearer(step, around.get(q))
+        slack = self.reserve_m if back else 0.0
+        return all(self._within(step, around.get(q), slack) or _nearer(step, around.get(q))
                    for q in self.parents)
 
     def ask(self, tick: int, step: Sequence[float] | None,
@@ -173,7 +186,7 @@ class Tether:
         With two parents it replaces one at a time: the first that forbids the step, else
         the one farthest from the base (in hops). ``cut``: parents whose link the step
         would lose for another reason than range (a wall, as the robot found)."""
-        if self.request is not None or self.pinned:
+        if self.request is not None:
             return []
         deepest = max(self.parents, key=lambda q: self._depth_of(q))
         if self.children:  # a relay may hop straight to the base: it is nobody's descendant
@@ -188,8 +201,9 @@ class Tether:
                 continue
             if blocking and self._within(step, around[r]):
                 replaced = blocking[0]
-            elif beat.depth < self._depth_of(deepest) and self._within((0.0, 0.0), around[r]):
-                replaced = deepest
+            elif (beat.depth < self._depth_of(deepest) and self._within((0.0, 0.0), around[r])
+                  and (step is None or deepest in blocking or self._within(step, around[r]))):
+                replaced = deepest  # never a parent that allows the step for one that forbids it
             else:
                 continue
             key = (beat.depth, math.hypot(*around[r]))
@@ -222,12 +236,13 @@ class Tether:
     def _depth_of(self, q: Hashable) -> float:
         return 0 if q == BASE else self.heard[q].depth if q in self.heard else math.inf
 
-    def _within(self, step: Sequence[float], offset: Sequence[float] | None) -> bool:
-        """Whether a robot at ``offset`` (m, relative to here) is within the leash after
-        ``step``."""
+    def _within(self, step: Sequence[float], offset: Sequence[float] | None,
+                slack: float = 0.0) -> bool:
+        """Whether a robot at ``offset`` (m, relative to here) is within the leash (plus
+        ``slack``, m) after ``step``."""
         if offset is None:
             return False
-        return math.hypot(offset[0] - step[0], offset[1] - step[1]) <= self.leash_m
+        return math.hypot(offset[0] - step[0], offset[1] - step[1]) <= self.leash_m + slack
 
 
 def _nearer(step: Sequence[float], offset: Sequence[float] | None) -> bool:
@@ -237,22 +252,33 @@ def _nearer(step: Sequence[float], offset: Sequence[float] | None) -> bool:
     return math.hypot(offset[0] - step[0], offset[1] - step[1]) <= math.hypot(*offset)
 
 
-def initial_parents(robot: int, need: int, first: int = 0) -> tuple[tuple, bool]:
-    """Parents on the root at the start, and whether they are pinned: with ``need`` 1, the
-    base; with 2, the base and the ``first`` robot on the root, which keeps the base as its
-    only parent for good (so the base and it form the biconnected core every other robot
-    hangs from by two distinct parents: rule 1 for ``biconnected``)."""
+def initial_parents(robot: int, need: int, first: int = 0) -> tuple:
+    """Parents on the root at the start: with ``need`` 1, the base; with 2, the base and
+    the ``first`` robot, which docks at the base (rule 1 for ``biconnected``:
+    :func:`docked`; ``robot`` must not be ``first``)."""
     if need == 1:
-        return (BASE,), False
-    return ((BASE,), True) if robot == first else ((BASE, first), False)
+        return (BASE,)
+    if robot == first:
+        raise ValueError(f"robot {robot} docks at the base: it keeps no tether")
+    return (BASE, first)
+
+
+def docked(flooder) -> "BaseStation":
+    """The first robot of a ``biconnected`` team, docked at the base (rule 1): the base's
+    partner, one hop from it, still for good; it adopts every robot that asks, floods on
+    and gossips as the base does."""
+    return BaseStation(flooder, parents=(BASE,))
 
 
 class BaseStation:
     """The base at the root: never moves, adopts every robot that asks, forwards flooded
-    messages once (``flooder``), and gossips what rule 5 needs."""
+    messages once (``flooder``), and gossips what rule 5 needs. With ``parents`` (the
+    base), the robot docked at it (:func:`docked`)."""
 
-    def __init__(self, flooder) -> None:
+    def __init__(self, flooder, parents: tuple = ()) -> None:
         self.flooder = flooder
+        self.parents = tuple(parents)
+        self.depth = 1 if parents else 0
         self.last_progress = 0
         self.known_edges = 0
 
@@ -264,8 +290,9 @@ class BaseStation:
                 self.last_progress = max(self.last_progress, p.last_progress)
                 self.known_edges = max(self.known_edges, p.known_edges)
             elif isinstance(p, Adopt):
-                out.append(Message(Adopted(0), to=m.sender))
+                out.append(Message(Adopted(self.depth), to=m.sender))
             elif self.flooder.fresh(p):
                 out.append(Message(p))
-        out.append(Message(Beat((), 0, True, self.last_progress, self.known_edges)))
+        out.append(Message(Beat(self.parents, self.depth, True, self.last_progress,
+                                self.known_edges)))
         return out

@@ -141,7 +141,8 @@ def register(subparsers) -> None:
                         help="none: explore as seed 003 (default); connected: every robot "
                              "keeps a radio route to the base at the root; biconnected: two "
                              "disjoint routes, so that one robot failing cuts nobody off "
-                             "(graph world only). "
+                             "(the first robot docks at the base as its partner and does "
+                             "not explore; needs 2 or more robots). "
                              "Needs --radio-range. A team that cannot go on says so "
                              "(infeasible) and stops. Robots stuck at the end of their "
                              "leash call relays, in both worlds")
@@ -294,10 +295,12 @@ def summary(result: dict) -> str:
                 f"{100 * result['connected_share']:.1f} % of the ticks ({result['cut_ticks']} "
                 f"cut), biconnected in {100 * result['biconnected_share']:.1f} %")
         if result["radio_messages"] is not None:
+            agreement = result["radio_belief_agreement"]
             lines.append(
                 f"radio: {result['radio_messages']} messages (busiest robot "
-                f"{result['radio_max_messages_per_robot']}); beliefs matched the truth in "
-                f"{100 * (result['radio_belief_agreement'] or 0):.1f} % of samples")
+                f"{result['radio_max_messages_per_robot']})" + (
+                    "" if agreement is None  # no connectivity tables in tethered runs
+                    else f"; beliefs matched the truth in {100 * agreement:.1f} % of samples"))
         if result["recording"]:
             lines.append(f"recording: {result['recording']}")
         if result["video"]:

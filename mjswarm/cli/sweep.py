@@ -60,11 +60,11 @@ def register(subparsers) -> None:
                         help="strategies, comma-separated (default: incidence-dfs)")
     parser.add_argument("--seeds", default="0", metavar="N,...", help="seeds, e.g. 0-29")
     parser.add_argument("--radio-ranges", default=None, metavar="M,...",
-                        help="graph world: radio ranges to sweep, m, e.g. 0.7,1,1.5 (default: "
-                             "no radio)")
+                        help="radio ranges to sweep, m, e.g. 0.7,1,1.5 (default: no radio; "
+                             "embodied without a constraint: connectivity tables)")
     parser.add_argument("--connectivity", default="none", metavar="C,...",
-                        help="graph world: constraints to sweep, of none, connected, "
-                             "biconnected (default: none; others need --radio-ranges)")
+                        help="constraints to sweep, of none, connected, biconnected "
+                             "(default: none; others need --radio-ranges)")
     parser.add_argument("--out", required=True, metavar="OUT", help="results file .jsonl or .csv")
     parser.add_argument("--backend", default="local",
                         help="local (process pool, default) or ray (pip install -e '.[ray]'; "

@@ -39,7 +39,8 @@ def sight_blocker(sim: Simulation, fixed: Mapping[Hashable, tuple[float, float]]
     """The radio's line-of-sight test on a simulation: a link between robots i and j is
     blocked unless each sees the other (:attr:`Simulation.sight` both ways); a link
     between a robot and a fixed node (a base station at ``fixed[address]``, m, its antenna
-    ``mast_m`` above the floor) unless the robot is seen from the antenna."""
+    ``mast_m`` above the floor, or a robot docked at it) unless the robot is seen from the
+    antenna; two fixed nodes always link."""
 
     def between_robots(pairs: np.ndarray) -> np.ndarray:
         i, j = np.asarray(pairs, np.int64).reshape(-1, 2).T
@@ -59,7 +60,8 @@ def sight_blocker(sim: Simulation, fixed: Mapping[Hashable, tuple[float, float]]
         for k in np.flatnonzero(~robots):
             a, b = pairs[k]
             node, robot = (a, b) if a in fixed else (b, a)
-            cut[k] = robot in fixed or not sim.sight.from_point(fixed[node], [robot], mast_m)[0]
+            if robot not in fixed:  # two masts see each other
+                cut[k] = not sim.sight.from_point(fixed[node], [robot], mast_m)[0]
         return cut
 
     return blocked

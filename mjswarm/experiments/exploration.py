@@ -40,8 +40,11 @@ injects faults, measures and records. Choices it makes, beyond the paper:
   the root joins the robots' radio (links need line of sight, as between robots); every
   robot keeps its tether (:mod:`algorithms.exploration.tether`) from a radio-ranging
   sensor (range and bearing of its radio neighbours); the base adopts, beats and floods
-  on; relays on demand (rule 6) walk back along edges by turning on their lane, and the
-  stations let a relay onto its requester's lane (:mod:`algorithms.exploration.entry`).
+  on; with ``biconnected`` the first robot in the launch order docks at the base (rule
+  1: it stays in the depot, its radio on the base's mast, as the graph world's first
+  robot stands on the root, and answers as the base does); relays on demand (rule 6)
+  walk back along edges by turning on their lane, and the stations let a relay onto its
+  requester's lane (:mod:`algorithms.exploration.entry`).
   A time unit of rules 5 and 6 is the mean edge at the run's speed plus a scan. Ground
   truth every tick: networkx on the radio graph with the base (``cut_ticks``, ``fragile_ticks``).
   The robots' own stall verdict (rule 5) replaces the ``stall_timeout_s`` check.
@@ -82,7 +85,7 @@ from algorithms.exploration.entry import (
 )
 from algorithms.exploration.explorer import Explorer, VertexCall
 from algorithms.exploration.relay import Flooder
-from algorithms.exploration.tether import BASE, BaseStation, Tether, initial_parents
+from algorithms.exploration.tether import BASE, BaseStation, Tether, docked, initial_parents
 from algorithms.navigation import NavigatorState
 from mjswarm.arena import ArenaSpec
 from mjswarm.arena.builder import arena_world_spec
@@ -93,7 +96,7 @@ from mjswarm.core.bearing import BearingSensor
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.faults import Fault
 from mjswarm.worlds.graphworld import ExplorationResult, make_minds, outcome
-from mjswarm.worlds.radiograph import CONNECTIVITY, NEED, infeasible_reason
+from mjswarm.worlds.radiograph import CONNECTIVITY, NEED, infeasible_reason, need_robots
 from mjswarm.outputs.recording import contact_event
 from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.navigation import calibration, conventions
@@ -106,6 +109,10 @@ from mjswarm.core.world import Pose2D
 #: The tether's leash keeps parents within the radio range less this (m): a control
 #: period's drive at top speed (4 mm), turns and the one-tick-old ranging, with room.
 TETHER_MARGIN_M = 0.02
+#: Of the leash, what only a walk back may use (m, the tether's ``reserve_m``): a U-turn
+#: sidesteps two lane offsets across its edge, with room for the odometry's back-up to
+#: where its lane ended.
+TURN_RESERVE_M = 2 * LANE_OFFSET_M + 0.02
 #: Height (m) of the base station's antenna at the root: above the robots (0.07 m tall),
 #: so that a robot standing on the root does not shadow the others; walls still block.
 BASE_MAST_M = 1.0
@@ -150,10 +157,11 @@ class EmbodiedConfig:
         wheel_slip: scale of the wheel-slip model (:class:`mjswarm.core.simulation.Simulation`).
         physics: ``"dynamic"`` (MuJoCo's contact physics) or ``"kinematic"`` (the fast
             tier, :mod:`mjswarm.core.kinematic`).
-        connectivity: ``"none"``, or ``"connected"`` (needs ``radio_range_m``): every
-            robot keeps its tether to a base station at the root
-            (:mod:`algorithms.exploration.tether`; see the module docstring).
-            ``"biconnected"`` is refused: it runs in the graph world only (README).
+        connectivity: ``"none"``, ``"connected"`` or ``"biconnected"`` (both need
+            ``radio_range_m``): every robot keeps its tether of one or two parents to a
+            base station at the root (:mod:`algorithms.exploration.tether`; see the
+            module docstring); with ``"biconnected"`` the first robot in
+            ``launch_order`` docks at the base (rule 1) and is never launched.
     """
 
     speed_m_s: float = PAPER_SPEED_M_S
@@ -258,10 +266,7 @@ class EmbodiedExploration(LoopFunctions):
         tied = config.connectivity != "none"
         if tied and config.radio_range_m is None:
             raise MjswarmError(f"connectivity {config.connectivity} needs a radio range")
-        if config.connectivity == "biconnected":  # a false verdict would mislead: refuse
-            raise MjswarmError(
-                "connectivity biconnected runs in the graph world only (--world graph): on "
-                "bodies the robot rule 1 pins for good stands in vertex areas the others need")
+        need_robots(config.connectivity, k)
         self.spec, self.minds, self.config, self.seed = spec, minds, config, seed
         self.recorder = recorder
         xs = [x for x, _ in spec.vertices.values()]
@@ -283,15 +288,21 @@ class EmbodiedExploration(LoopFunctions):
                                 beacon_at=self._beacon_at, ranging=tied)
         self.uplink = Uplink(STATION)
         self.world.uplinks[STATION] = self.uplink
-        self.base = None
+        self.base = self.dock = None
+        root_xy = tuple(spec.vertices[spec.root])
         if tied:  # the base station at the root, on the robots' radio
-            self.world.fixed = {BASE: tuple(spec.vertices[spec.root])}
+            self.world.fixed = {BASE: root_xy}
             self.base = BaseStation(Flooder())
+        if NEED.get(config.connectivity) == 2:  # rule 1: the first robot docks at the base
+            self.world.docked = {order[0]: root_xy}
+            self.dock = docked(Flooder())
+            order = order[1:]
         if config.radio_range_m is not None:
             self.world.attach_radio(Radio([*range(k), *self.world.fixed],
                                           range_m=config.radio_range_m,
-                                          blocked=sight_blocker(self.sim, self.world.fixed,
-                                                                BASE_MAST_M)))
+                                          blocked=sight_blocker(
+                                              self.sim, {**self.world.fixed, **self.world.docked},
+                                              BASE_MAST_M)))
         avoid = config.collision_avoidance
         cal, conv = calibration(geometry), conventions(geometry)
         self.robots = [
@@ -302,7 +313,8 @@ class EmbodiedExploration(LoopFunctions):
                      config.turn_rate_rad_s, config.idle_wait_s,
                      ConnectivityTable(i, 0) if config.radio_range_m is not None and not tied
                      else None,
-                     self.sim.control_dt_s, self._tether(i, order[0]) if tied else None)
+                     self.sim.control_dt_s,
+                     self._tether(i) if tied and i not in self.world.docked else None)
             for i, (mind, e) in enumerate(zip(minds, eps))]
         self.beacons = {v: Beacon() for v in spec.vertices}
         self.beacon_vertex: dict[str, str] = {}
@@ -354,8 +366,8 @@ class EmbodiedExploration(LoopFunctions):
     @property
     def done(self) -> list[bool]:
         """Which robots are finished: stopped, failed or declared."""
-        return [r.halted is not None or r.declared or d
-                for r, d in zip(self.robots, self.dead)]
+        return [r.halted is not None or r.declared or d or i in self.world.docked
+                for i, (r, d) in enumerate(zip(self.robots, self.dead))]
 
     # ------------------------------------------------------------------ loop
     def run(self, progress: bool = False) -> EmbodiedResult:
@@ -426,6 +438,10 @@ class EmbodiedExploration(LoopFunctions):
         if self.base is not None:
             for m in self.base.step(radio.receive(BASE)):
                 radio.send(BASE, m.payload, m.to)
+            for i in self.world.docked:
+                if not self.dead[i]:
+                    for m in self.dock.step(radio.receive(i)):
+                        radio.send(i, m.payload, m.to)
         elif radio is not None and self.sim.step_count % 10 == 0 and self.sim.step_count:
             graph = radio.graph()
             self._truth = awareness_truth(graph, 0, range(1, len(self.robots)))
@@ -699,7 +715,7 @@ class EmbodiedExploration(LoopFunctions):
             self._nearest_version = sim.state_version
         return self._vertex_ids[self._nearest[i]], float(self._nearest_m[i])
 
-    def _tether(self, i: int, first: int) -> Tether:
+    def _tether(self, i: int) -> Tether:
         """Robot ``i``'s tether: a time unit (rules 5 and 6 count in them) is what the
         graph world's edge stands for, the mean edge at the run's speed and the scan at
         the vertex it leads to (one full turn)."""
@@ -709,8 +725,10 @@ class EmbodiedExploration(LoopFunctions):
                                 for u, v in spec.edges]))
         unit_s = mean_m / cfg.speed_m_s + 2.0 * math.pi / cfg.turn_rate_rad_s
         ticks = max(1, round(unit_s / self.sim.control_dt_s))
-        return Tether(i, self.config.radio_range_m, *initial_parents(i, need, first),
-                      margin_m=TETHER_MARGIN_M, ticks_per_unit=ticks)
+        first = next(iter(self.world.docked), None)
+        return Tether(i, self.config.radio_range_m, initial_parents(i, need, first),
+                      margin_m=TETHER_MARGIN_M, ticks_per_unit=ticks,
+                      reserve_m=TURN_RESERVE_M)
 
     def _infeasible_reason(self) -> str:
         return infeasible_reason(len(self.robots), self.config.radio_range_m, self.paths,

@@ -1,8 +1,10 @@
 """Parameter sweeps: a grid of exploration runs, in parallel, resumable (issue 8 part 3).
 
 A sweep is the product arenas x robot counts x strategies x seeds x radio ranges x
-connectivity constraints in one world (``graph`` or ``embodied``; ranges and constraints in
-the graph world only, :mod:`mjswarm.worlds.radiograph`). Each cell is one run of :func:`run_cell`; results are appended to one
+connectivity constraints in one world (``graph``, :mod:`mjswarm.worlds.radiograph`, or
+``embodied``, :mod:`mjswarm.experiments.exploration` at its default speed; a range without
+a constraint gives the embodied robots connectivity tables, as ``mjswarm explore`` does).
+Each cell is one run of :func:`run_cell`; results are appended to one
 file as they finish, one record per cell (JSON lines, or CSV with list-valued fields as
 JSON text), so a sweep that is stopped and started again skips the cells already in the
 file. Backends: a local process pool (default) or a Ray cluster (``backend="ray"``; the
@@ -56,7 +58,7 @@ def grid(world: str, arenas: Iterable[str], robots: Iterable[int], strategies: I
     constraint, K < 1, a range that is not positive, a constraint without a range)."""
     from algorithms.exploration import STRATEGIES
     from mjswarm.arena import load_arena
-    from mjswarm.worlds.radiograph import CONNECTIVITY
+    from mjswarm.worlds.radiograph import CONNECTIVITY, need_robots
 
     ranges, connectivities = list(ranges), list(connectivities)
     for c in connectivities:
@@ -64,9 +66,6 @@ def grid(world: str, arenas: Iterable[str], robots: Iterable[int], strategies: I
             raise MjswarmError(f"unknown connectivity '{c}' (choose from {', '.join(CONNECTIVITY)})")
     if any(r is not None and not r > 0 for r in ranges):
         raise MjswarmError("radio ranges must be positive (m)")
-    if world != "graph" and (ranges != [None] or connectivities != ["none"]):
-        raise MjswarmError("radio ranges and connectivity constraints sweep in the graph "
-                           "world only (--world graph)")
     if None in ranges and any(c != "none" for c in connectivities):
         raise MjswarmError("a connectivity constraint needs radio ranges (--radio-ranges)")
     if world not in WORLDS:
@@ -82,6 +81,8 @@ def grid(world: str, arenas: Iterable[str], robots: Iterable[int], strategies: I
     if max(robots) > MAX_ROBOTS:
         raise MjswarmError(f"robot counts must be <= {MAX_ROBOTS} (got {max(robots)}; "
                            "mjswarm bench measures up to 1000 robots)")
+    for c in connectivities:
+        need_robots(c, min(robots))
     if not (arenas and strategies and seeds):
         raise MjswarmError("a sweep needs at least one arena, strategy and seed")
     return [Cell(world, a, k, s, seed, r, c) for a, k, s, seed, r, c in
@@ -105,9 +106,11 @@ def run_cell(cell: Cell) -> dict:
                 make_minds(cell.strategy, cell.robots, cell.seed), seed=cell.seed,
                 arena=spec.name)
     else:
-        from mjswarm.experiments.exploration import explore_embodied
+        from mjswarm.experiments.exploration import EmbodiedConfig, explore_embodied
 
-        result = explore_embodied(spec, cell.robots, cell.strategy, seed=cell.seed)
+        result = explore_embodied(spec, cell.robots, cell.strategy, seed=cell.seed,
+                                  config=EmbodiedConfig(radio_range_m=cell.radio_range_m,
+                                                        connectivity=cell.connectivity))
     record = result.to_dict()
     record.pop("paths", None)
     return {**asdict(cell), **{k: v for k, v in record.items() if k not in CELL_KEYS}}

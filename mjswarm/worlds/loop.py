@@ -57,6 +57,9 @@ class World(ABC):
     #: radio nodes that never move, by address: position (m) (a base station); the radio
     #: knows them after the robots, in this order
     fixed: Mapping = NOTHING
+    #: robots off the floor whose radio is on the air at a fixed point, by id: position
+    #: (m) (a robot docked at a base station, rule 1 of :mod:`algorithms.exploration.tether`)
+    docked: Mapping = NOTHING
 
     @property
     @abstractmethod
@@ -107,7 +110,7 @@ class World(ABC):
                                "world's fixed nodes")
         self.radio = radio
         for i in range(self.n):
-            if not self.present[i]:
+            if not self.present[i] and i not in self.docked:
                 radio.remove(i)
         self.relink()
 
@@ -125,8 +128,12 @@ class World(ABC):
             self.radio.move(self._air_positions())
 
     def _air_positions(self) -> np.ndarray:
-        """Where the radio's nodes are (m): the robots 0 .. n - 1, then the fixed nodes."""
+        """Where the radio's nodes are (m): the robots 0 .. n - 1 (docked ones where they
+        are docked), then the fixed nodes."""
         xy = self.true_poses()[:, :2]
+        if self.docked:
+            xy = xy.copy()
+            xy[list(self.docked)] = list(self.docked.values())
         return np.vstack([xy, list(self.fixed.values())]) if self.fixed else xy
 
     def _radio_step(self) -> None:

@@ -42,7 +42,7 @@ import numpy as np
 
 from algorithms.exploration import Beacon, Strategy
 from algorithms.exploration.relay import ConnectedExplorer, Flooder
-from algorithms.exploration.tether import BASE, BaseStation, Tether, initial_parents
+from algorithms.exploration.tether import BASE, BaseStation, Tether, docked, initial_parents
 from mjswarm.core.radio import Radio
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.graphworld import ExplorationResult, GraphWorld, outcome
@@ -60,6 +60,14 @@ def infeasible_reason(robots: int, range_m: float, paths: list[list], edges: int
     explored = {tuple(sorted(e)) for p in paths for e in zip(p, p[1:])}
     return (f"infeasible with {robots} robots at range {range_m:g} m: explored "
             f"{len(explored)} of {edges} edges")
+
+
+def need_robots(connectivity: str, robots: int) -> None:
+    """Refuse a ``biconnected`` team of one: its first robot docks at the base (rule 1 of
+    :mod:`algorithms.exploration.tether`), so nobody would explore."""
+    if NEED.get(connectivity) == 2 and robots < 2:
+        raise MjswarmError("connectivity biconnected needs at least 2 robots: the first "
+                           "docks at the base (rule 1 of the tether)")
 
 
 @dataclass
@@ -116,8 +124,12 @@ class RadioGraphWorld:
         if max_time is None:
             max_time = 50 * (len(w.edges) + 1) + 100
         constrained = self.connectivity != "none"
+        need_robots(self.connectivity, k)
         need = NEED.get(self.connectivity, 1)
-        robots = [ConnectedExplorer(i, minds[i], Tether(i, self.range_m, *initial_parents(i, need),
+        # rule 1 for biconnected: robot 0 docks at the base (it stands on the root)
+        dock = docked(Flooder()) if need == 2 else None
+        robots = [None if dock is not None and i == 0 else
+                  ConnectedExplorer(i, minds[i], Tether(i, self.range_m, initial_parents(i, need),
                                                         ticks_per_unit=TICKS_PER_UNIT))
                   for i in range(k)]
         base = BaseStation(Flooder())
@@ -134,7 +146,7 @@ class RadioGraphWorld:
         radio.move(xy)
         declared = infeasible = None
         cut = fragile = ticks = 0
-        order = range(k - 1, -1, -1)
+        order = [i for i in range(k - 1, -1, -1) if robots[i] is not None]
         last_tick = math.floor(max_time * TICKS_PER_UNIT)
         while declared is None and infeasible is None and ticks < last_tick:
             tick = ticks = ticks + 1
@@ -146,6 +158,9 @@ class RadioGraphWorld:
                         radio.send(i, m.payload, m.to)
                 for m in base.step(radio.receive(BASE)):
                     radio.send(BASE, m.payload, m.to)
+                if dock is not None:
+                    for m in dock.step(radio.receive(0)):
+                        radio.send(0, m.payload, m.to)
             deciding = [i for i in order if at[i] is not None and wake[i] <= tick]
             for i in deciding:  # bookkeeping first, then decisions (graph world)
                 robots[i].arrive(beacons[at[i]], w.angles[at[i]], arrived_by[i])
@@ -194,7 +209,7 @@ class RadioGraphWorld:
                     for m in robots[i].after(tick, wanted.get(i), i in moved,
                                              self._around(radio, i, xy)):
                         radio.send(i, m.payload, m.to)
-                if any(r.tether.stalled(tick) for r in robots):
+                if any(robots[i].tether.stalled(tick) for i in order):
                     infeasible = tick
             graph = self._radio_graph(xy)
             cut += not nx.is_connected(graph)
@@ -208,7 +223,7 @@ class RadioGraphWorld:
             **fields, connectivity=self.connectivity, radio_range_m=self.range_m,
             messages=radio.total_sent, connected_share=1.0 - cut / max(ticks, 1),
             cut_ticks=cut, biconnected_share=1.0 - fragile / max(ticks, 1),
-            fragile_ticks=fragile, relay_trips=sum(r.relay_trips for r in robots),
+            fragile_ticks=fragile, relay_trips=sum(robots[i].relay_trips for i in order),
             infeasible=infeasible is not None, reason=reason)
 
     def _step(self, e: tuple[str, str], progress: float,

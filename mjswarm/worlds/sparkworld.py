@@ -49,6 +49,7 @@ class SparkWorld(World):
         self.beacon_at = beacon_at
         self.uplinks = {}
         self.fixed = {}
+        self.docked = {}
         self.ranging = ranging
         self._v = [0.0] * self.n  # commands of this tick, as floats (cheaper than numpy items)
         self._w = [0.0] * self.n
@@ -89,7 +90,8 @@ class SparkWorld(World):
         x, y, yaw = poses[i]
         out = {}
         for j in neighbors:
-            jx, jy = self.fixed[j] if j in self.fixed else poses[j, :2]
+            jx, jy = (self.fixed[j] if j in self.fixed else self.docked[j] if j in self.docked
+                      else poses[j, :2])
             bearing = math.remainder(math.atan2(jy - y, jx - x) - yaw, 2 * math.pi)
             out[j] = Detection(math.hypot(jx - x, jy - y), bearing)
         return out
