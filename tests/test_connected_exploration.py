@@ -352,6 +352,20 @@ def test_embodied_biconnected_team_completes_with_its_first_robot_docked():
     assert result.fragile_ticks == 0 and result.biconnected_share == 1.0
 
 
+def test_embodied_biconnected_team_reports_when_its_docked_robot_fails():
+    """R1, docked at the base, fails at 5 s: the two explorers have lost a parent and
+    cannot be each other's second parent (rule 1 orders parents), so they stand, and the
+    team declares itself infeasible (rule 5, at 345 s) instead of standing until the time
+    limit (3600 s), as it did before session 9."""
+    from mjswarm.experiments.faults import RobotFailure
+
+    result = embodied("arena1", 3, 3.0, seed=0, connectivity="biconnected", speed_m_s=0.1,
+                      faults=[RobotFailure(0, 5.0)])
+    assert result.infeasible and result.ended_because.startswith("infeasible with 3 robots")
+    assert result.sim_time_s < 1000.0 and result.cut_ticks == 0
+    assert result.stopped_robots[0]["robot"] == 1 and result.collisions == 0
+
+
 @pytest.mark.slow
 def test_embodied_too_short_a_range_ends_in_a_verdict():
     """1.5 m: walls cut links the leash cannot foresee; the robots back out of each cut

@@ -246,6 +246,8 @@ class Explorer(Controller):
         parent as if the leash had stopped it (on a vertex centre, at once: a robot backed
         out of the centre it scans on would scan off it, find no beacon and stop, as one
         did on ``arena2`` before session 9)."""
+        if self.tether.stalled(now):  # a parent that failed for good is never back
+            self.infeasible = True
         self._occluded.add(self._way)
         self._cut |= {q for q in self.tether.parents if q not in around}
         if not self._trail:

@@ -413,7 +413,9 @@ class EmbodiedExploration(LoopFunctions):
         """One line for logs: where the run is."""
         return (f"explore {self.spec.name}: {self.sim.time_s:.0f} s simulated in "
                 f"{wall_s:.0f} s, {self._traversals()} edge traversals, "
-                f"{sum(self.active)} of {len(self.active)} robots launched, "
+                f"{sum(a for j, a in enumerate(self.active) if j not in self.world.docked)} "
+                f"of {len(self.active)} robots launched"
+                f"{', 1 docked at the base' if self.world.docked else ''}, "
                 f"{len(self.stopped)} stopped")
 
     def finished(self) -> bool:
