@@ -10,7 +10,9 @@ at the root. Radio links join robots, and the base, within ``radio_range_m`` of 
 ``connectivity``:
 
 * ``"none"``: seed 003 unchanged (robots never wait; no messages).
-* ``"connected"`` / ``"biconnected"``: each robot keeps its tether of one / two parents (:mod:`algorithms.exploration.tether`) and
+* ``"connected"`` / ``"biconnected"``: each robot keeps its tether of one / two parents
+  (:mod:`algorithms.exploration.tether`; with ``biconnected`` robot 0 docks at the base,
+  rule 1, and explores nothing) and
   stuck robots are brought relays (:mod:`algorithms.exploration.relay`); robots walk
   edges both ways and may stop part-way.
 
