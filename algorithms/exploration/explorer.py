@@ -183,11 +183,15 @@ class Explorer(Controller):
                 self.connected.retire()  # it serves as nobody's relay
             return self._stand(now, out, around)
         if self.tether is not None and not all(q in around for q in self.tether.parents):
-            return self._retrace(now, out, around)
-        command = self._drive(observation, out)
-        if self.tether is None:
-            return command
-        return self._leash(now, command, around)
+            command = self._retrace(now, out, around)
+        else:
+            command = self._drive(observation, out)
+            if self.tether is None:
+                return command
+            command = self._leash(now, command, around)
+        if self.tether.stalled(now):  # rule 5 (a robot whose parent failed judges it too)
+            self.infeasible = True
+        return command
 
     def _hear(self, now: int, observation: Observation, around, out: list[Message]) -> None:
         """Its connected exploration reads the radio; what rule 6 asks of vertex entry."""
@@ -203,7 +207,7 @@ class Explorer(Controller):
 
     def _leash(self, now: int, command: Command, around) -> Command:
         """Rules 3-6 on this tick's command: it stands where the leash (or a wall it met
-        on this leg) forbids its drive, then asks, beats, and judges the stall."""
+        on this leg) forbids its drive, then asks and beats."""
         wanted = None
         if command.v_m_s != 0.0:
             step = (command.v_m_s * self.control_dt_s, 0.0)  # in its own frame
@@ -220,8 +224,6 @@ class Explorer(Controller):
         out = list(command.messages)
         out += self.connected.after(now, wanted, command.v_m_s != 0.0, around, self._held,
                                     self._cut if self._way in self._occluded else ())
-        if self.tether.stalled(now):
-            self.infeasible = True
         return command._replace(messages=tuple(out))
 
     def _set_out(self, now_s: float, out: list[Message]) -> None:
@@ -246,8 +248,6 @@ class Explorer(Controller):
         parent as if the leash had stopped it (on a vertex centre, at once: a robot backed
         out of the centre it scans on would scan off it, find no beacon and stop, as one
         did on ``arena2`` before session 9)."""
-        if self.tether.stalled(now):  # a parent that failed for good is never back
-            self.infeasible = True
         self._occluded.add(self._way)
         self._cut |= {q for q in self.tether.parents if q not in around}
         if not self._trail:
