@@ -4,11 +4,15 @@ Seed 002's S-coverage experiment (biconnected add / remove) on kinematic points,
 communication ranges the paper reports, plotted episode by episode against the paper's
 means.
 
-    python examples/coverage_plot.py                          # 40 episodes, coverage.png
+    python examples/coverage_plot.py              # 40 episodes, recordings/coverage.png
     python examples/coverage_plot.py --episodes 100 --world embodied --out cov.pdf
+
+It runs from any directory: the default picture goes to the repository's recordings/
+folder; a relative ``--out`` is taken from the current directory.
 """
 
 import argparse
+from pathlib import Path
 
 import matplotlib
 
@@ -21,7 +25,10 @@ parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--episodes", type=int, default=40)
 parser.add_argument("--world", choices=("point", "embodied"), default="point")
 parser.add_argument("--seed", type=int, default=0)
-parser.add_argument("--out", default="coverage.png")
+parser.add_argument("--out", default=str(Path(__file__).resolve().parents[1] / "recordings"
+                                         / "coverage.png"),
+                    help="the picture to write (.png, .svg, .pdf; default: recordings/"
+                         "coverage.png in the repository)")
 args = parser.parse_args()
 
 fig, ax = plt.subplots(figsize=(7, 4))

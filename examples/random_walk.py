@@ -6,12 +6,16 @@ with a command; the same class runs unchanged on kinematic points and on MuJoCo 
 robots, and each run is recorded with rerun (open it with ``mjswarm view FILE.rrd``).
 
     python examples/random_walk.py                  # 8 robots, 60 s in each world
-    python examples/random_walk.py --robots 12 --seconds 120 --out recordings
+    python examples/random_walk.py --robots 12 --seconds 120 --out /tmp
+
+It runs from any directory: the recordings go to the repository's recordings/ folder
+unless ``--out`` names another (a relative one is taken from the current directory).
 """
 
 import argparse
 import math
 import random
+from pathlib import Path
 
 from algorithms.robot import Command, Controller, Observation
 from mjswarm.worlds.loop import Loop
@@ -49,7 +53,8 @@ class RandomWalk(Controller):
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--robots", type=int, default=8)
 parser.add_argument("--seconds", type=float, default=60.0, help="simulated time per world")
-parser.add_argument("--out", default="recordings", help="folder for the .rrd files")
+parser.add_argument("--out", default=str(Path(__file__).resolve().parents[1] / "recordings"),
+                    help="folder for the .rrd files (default: recordings/ in the repository)")
 args = parser.parse_args()
 
 starts = spread(args.robots, radius_m=1.0, seed=1)

@@ -15,3 +15,13 @@ def one_line(exc: BaseException, limit: int = 240) -> str:
     """An exception's message folded onto one line (for third-party multi-line errors)."""
     text = " ".join(str(exc).split()) or type(exc).__name__
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a run: still a :class:`KeyboardInterrupt`, carrying what the run had
+    measured so far (``result``, with ``ended_because == "interrupted"``) so that the CLI
+    can write it (``--json``) and summarise it before it exits."""
+
+    def __init__(self, result) -> None:
+        super().__init__("interrupted")
+        self.result = result

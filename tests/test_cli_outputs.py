@@ -50,9 +50,11 @@ def test_an_interrupted_run_keeps_a_valid_partial_recording(tmp_path, capsys, mo
     assert main(["explore", "--arena", "arena1", "--robots", "2", "--record",
                  str(target)]) == 130
     err = capsys.readouterr().err
-    assert "interrupted; partial output kept" in err and str(target) in err
-    assert [p.name for p in tmp_path.iterdir()] == ["run.rrd"]
-    done = subprocess.run([*rerun_command(), "rrd", "verify", str(target)], check=False,
+    partial = tmp_path / "run.partial.rrd"  # beside the user's earlier file (issue 26)
+    assert "interrupted; partial output kept" in err and str(partial) in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.partial.rrd", "run.rrd"]
+    assert target.read_bytes() == b"old"
+    done = subprocess.run([*rerun_command(), "rrd", "verify", str(partial)], check=False,
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
 
@@ -94,7 +96,7 @@ def test_embodied_options_with_the_graph_world_are_errors(capsys, option):
 @pytest.mark.parametrize("argv,message", [
     (["--max-time", "-5"], "--max-time must be positive"),
     (["--max-time", "0"], "--max-time must be positive"),
-    (["--launch-interval", "-1"], "--launch-interval must be >= 0"),
+    (["--launch-interval", "-1"], "--launch-interval must be a finite number >= 0"),
     (["--edge-time", "length"], "--edge-time only applies to the graph world"),
 ])
 def test_impossible_values_are_errors(capsys, argv, message):

@@ -43,3 +43,18 @@ def test_an_experiment_run_from_python_is_plotted(tmp_path, suffix):
     target = tmp_path / f"coverage{suffix}"
     out = run("coverage_plot.py", "--episodes", "4", "--out", str(target), cwd=tmp_path)
     assert "cr 2: mean S-coverage" in out and target.stat().st_size > 5_000
+
+
+def test_examples_run_from_any_directory_and_write_where_they_say(tmp_path):
+    """Issue 26: from another directory the default output goes to the repository's
+    recordings/ folder (it used to fail, or litter the working directory)."""
+    target = EXAMPLES.parent / "recordings" / "coverage.png"
+    existed = target.exists()
+    before = target.stat().st_mtime_ns if existed else None
+    out = run("coverage_plot.py", "--episodes", "2", cwd=tmp_path)
+    try:
+        assert f"plot: {target}" in out and target.stat().st_mtime_ns != before
+        assert list(tmp_path.iterdir()) == []  # nothing left in the working directory
+    finally:
+        if not existed:
+            target.unlink(missing_ok=True)

@@ -63,7 +63,7 @@ def test_a_dead_robot_stops_and_the_others_finish_with_the_true_map():
     assert result.completed and result.map_correct and result.collisions == 0
     assert [s["robot"] for s in result.stopped_robots] == [3]
     assert result.stopped_robots[0]["at_s"] == pytest.approx(30.0, abs=0.05)
-    assert result.faults == [{"fault": "robot:3@30", "at_s": pytest.approx(30.0, abs=0.05)}]
+    assert result.faults == [{"fault": "robot:3@30", "fired": True, "at_s": pytest.approx(30.0, abs=0.05)}]
     assert result.traversals_per_robot[2] == 0
 
 
@@ -92,7 +92,7 @@ def test_a_wiped_beacon_is_reported():
     config = EmbodiedConfig(speed_m_s=0.1, faults=[parse_fault("beacon:v1@40")],
                             max_sim_time_s=900)
     result = explore_embodied(load_arena("arena1"), 1, config=config, seed=0)
-    assert result.faults == [{"fault": "beacon:v1@40", "at_s": pytest.approx(40.0, abs=0.05)}]
+    assert result.faults == [{"fault": "beacon:v1@40", "fired": True, "at_s": pytest.approx(40.0, abs=0.05)}]
     assert result.ended_because in ("completed", "stalled", "all robots stopped", "max time")
     if result.completed:
         assert result.map_correct == (sorted(result.map_edges) == sorted(
@@ -153,5 +153,5 @@ def test_cli_reports_faults_and_stopped_robots(capsys):
     assert result["ended_because"] == "all robots stopped"
     assert result["stopped_robots"] == [
         {"robot": 1, "reason": "failed (fault robot:1@5)", "at_s": 5.0}]
-    assert result["faults"] == [{"fault": "robot:1@5", "at_s": 5.0}]
+    assert result["faults"] == [{"fault": "robot:1@5", "fired": True, "at_s": 5.0}]
     assert result["sim_time_s"] < 6.0 and result["heading_error_deg"] >= 0.0

@@ -71,7 +71,7 @@ from scipy.spatial import Delaunay
 
 from mjswarm.arena import geometry
 
-from mjswarm.arena.spec import ArenaSpec
+from mjswarm.arena.spec import MAX_VERTICES, ArenaSpec
 from mjswarm.errors import MjswarmError
 
 #: Default lattice spacing (m), also used by the random generators.
@@ -121,6 +121,11 @@ def generate(text: str) -> ArenaSpec:
             f"bad arena generator {text!r}: expected {GENERATORS[kind]} (whole numbers"
             + (", SPACING in metres)" if kind == "lattice" else ")")
         )
+    counts = [int(g) for g in match.groups()[:2] if g is not None and g.isdigit()]
+    size = counts[0] * counts[1] if "x" in text else counts[0]  # RxC, else V, E or N
+    if size > MAX_VERTICES:
+        raise MjswarmError(f"{text}: about {size} vertices; arenas have at most "
+                           f"{MAX_VERTICES}")
     if kind == "lattice":
         rows, cols, spacing = match.groups()
         if spacing is None:

@@ -38,16 +38,26 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def check_seeds(seeds, flag: str) -> None:
+    """Seeds seed numpy's generators, which take any whole number >= 0; refuse the rest
+    in one line."""
+    bad = [s for s in seeds if s is not None and s < 0]
+    if bad:
+        raise MjswarmError(f"{flag} must be a whole number >= 0, got {bad[0]}")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        check_seeds([getattr(args, "seed", None)], "--seed")
         return int(args.func(args) or 0)
     except MjswarmError as exc:
         print(f"mjswarm: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        kept = ", ".join(interrupted_outputs)
+        kept = ", ".join(where if where == asked else f"{where} ({asked} left as it was)"
+                         for asked, where in interrupted_outputs.items())
         print("mjswarm: interrupted" + (f"; partial output kept: {kept}" if kept else ""),
               file=sys.stderr)
         return 130

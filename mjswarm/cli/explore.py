@@ -7,15 +7,16 @@ world is a function ``run_<world>(args) -> dict`` registered in :data:`WORLDS`.
 
 from __future__ import annotations
 
+import math
 from contextlib import ExitStack
 
 from algorithms.collision import PAPER_SPEED_M_S
 from algorithms.exploration import STRATEGIES
-from mjswarm.cli.output import atomic_output, check_writable, write_json
+from mjswarm.cli.output import atomic_output, check_outputs, check_writable, write_json
 from mjswarm.cli.video_options import add_video_options, check_video
 from mjswarm.core.kinematic import PHYSICS
 from mjswarm.core.robot import spark_v_geometry
-from mjswarm.errors import MjswarmError
+from mjswarm.errors import MjswarmError, RunInterrupted
 from mjswarm.worlds.graphworld import EDGE_TIMES, GraphWorld
 from mjswarm.worlds.radiograph import CONNECTIVITY
 
@@ -57,13 +58,7 @@ def run_embodied(args) -> dict:
     if args.root and args.root != spec.root:
         spec = ArenaSpec(spec.name, args.root, spec.vertices, spec.edges, spec.description,
                          spec.source)
-    order = None
-    if args.launch_order:
-        try:
-            order = [int(x) - 1 for x in args.launch_order.split(",")]
-        except ValueError:
-            raise MjswarmError(f"--launch-order takes robot numbers like 2,1,3, "
-                               f"got '{args.launch_order}'") from None
+    order = launch_order(args.launch_order, args.robots)
     defaults = EmbodiedConfig()
     config = EmbodiedConfig(
         speed_m_s=_or(args.speed, defaults.speed_m_s),
@@ -77,7 +72,7 @@ def run_embodied(args) -> dict:
         wheel_slip=_or(args.wheel_slip, 0.0), physics=args.physics or defaults.physics,
         connectivity=args.connectivity or "none")
     run = EmbodiedExploration(spec, make_minds(args.strategy, args.robots, args.seed), config,
-                              args.seed)
+                              args.seed, progress=True)
     with ExitStack() as outputs:
         if args.record:
             temp = outputs.enter_context(atomic_output(args.record, "recording"))
@@ -91,9 +86,34 @@ def run_embodied(args) -> dict:
                           marks=run.dropped_beacons, title=f"{spec.name}, {args.robots} robots")
             run.loop.add(video)
         with filming(video, run.recorder):
-            result = run.run(progress=True)
+            try:
+                result = run.run(progress=True)
+            except RunInterrupted as stop:  # the outputs keep their partial contents
+                stop.result = _embodied_dict(stop.result, args)
+                raise
+    return _embodied_dict(result, args)
+
+
+def _embodied_dict(result, args) -> dict:
+    """An embodied run's JSON-ready result, with where its outputs went."""
     return {"world": "embodied", **result.to_dict(), "recording": args.record,
             "video": args.video}
+
+
+def launch_order(text: str | None, k: int) -> list[int] | None:
+    """``--launch-order 3,1,2`` as 0-based robot indices; one line, in R1..RK numbers,
+    if it is not an order of all K robots."""
+    if not text:
+        return None
+    try:
+        numbers = [int(x) for x in text.split(",")]
+    except ValueError:
+        raise MjswarmError(f"--launch-order takes robot numbers like 2,1,3, "
+                           f"got '{text}'") from None
+    if sorted(numbers) != list(range(1, k + 1)):
+        raise MjswarmError(f"--launch-order must name each of R1..R{k} once (robot numbers "
+                           f"1..{k}, e.g. {','.join(map(str, range(k, 0, -1)))}), got {text}")
+    return [n - 1 for n in numbers]
 
 
 def _or(value, default):
@@ -101,6 +121,8 @@ def _or(value, default):
     return default if value is None else value
 
 
+#: Teams up to this size have their traversals listed robot by robot in the summary.
+SUMMARY_ROBOTS = 20
 #: World name -> runner.
 WORLDS = {"embodied": run_embodied, "graph": run_graph}
 
@@ -235,74 +257,114 @@ def check_options(args) -> None:
         raise MjswarmError(f"radio range must be positive, got {args.radio_range:g} m")
     if args.max_time is not None and not args.max_time > 0:
         raise MjswarmError(f"--max-time must be positive, got {args.max_time:g}")
-    if args.launch_interval is not None and not args.launch_interval >= 0:
-        raise MjswarmError(f"--launch-interval must be >= 0 s, got {args.launch_interval:g}")
+    for flag, value, least in (("--speed", args.speed, 0.0), ("--stall-timeout",
+                               args.stall_timeout, 0.0), ("--launch-interval",
+                               args.launch_interval, None), ("--line-noise", args.line_noise,
+                               None), ("--ir-noise", args.ir_noise, None),
+                               ("--wheel-slip", args.wheel_slip, None)):
+        _check_number(flag, value, least)
+    if args.launch_order:
+        launch_order(args.launch_order, args.robots)
     check_writable(args.json, "JSON")
+    check_outputs({"--record": args.record, "--video": args.video, "--json": args.json},
+                  {"--record": ".rrd"})
     check_video(args)
+
+
+def _check_number(flag: str, value: float | None, above: float | None) -> None:
+    """Refuse, naming ``flag``, a value that is not a finite number greater than
+    ``above`` (None: at least 0)."""
+    if value is None:
+        return
+    if above is None and not (math.isfinite(value) and value >= 0):
+        raise MjswarmError(f"{flag} must be a finite number >= 0, got {value:g}")
+    if above is not None and not (math.isfinite(value) and value > above):
+        raise MjswarmError(f"{flag} must be a finite number > {above:g}, got {value:g}")
 
 
 def run(args) -> int:
     check_options(args)
-    result = WORLDS[args.world](args)
-    if write_json(result, args.json):
-        return 0 if result["completed"] else 1
-    print(summary(result))
+    try:
+        result = WORLDS[args.world](args)
+    except RunInterrupted as stop:  # say what is known, then exit as interrupted
+        report(stop.result, args, partial=True)
+        raise
+    report(result, args)
     return 0 if result["completed"] else 1
 
 
+def report(result: dict, args, partial: bool = False) -> None:
+    """The result to ``--json`` and the summary to stdout (unless the JSON went there)."""
+    if not write_json(result, args.json, partial):
+        print(summary(result))
+
+
 def summary(result: dict) -> str:
-    """Human-readable lines for one run."""
+    """Human-readable lines for one run, the same for every ending."""
     head = (f"{result['arena']}: {result['robots']} robot(s), {result['strategy']}, "
             f"{result['world']} world, root {result['root']}")
-    radio = []
+    traversals = f"traversals: {result['total_traversals']} in total " \
+                 f"({per_robot(result['traversals_per_robot'])})"
+    if result["completed"]:
+        verdict = "equal to" if result["map_correct"] else "DIFFERENT from"
+        unit = "edges (most by any robot)" if result["world"] == "embodied" else "steps"
+        lines = [head,
+                 f"completed: R{result['declared_by']} declared completion at "
+                 f"{result['declared_at']}; makespan {result['makespan']:g} {unit}",
+                 traversals,
+                 f"map: {len(result['map_edges'])} edges, {verdict} the arena's"]
+    else:
+        why = result.get("reason") or result.get("ended_because") or "max time"
+        lines = [head, f"not completed ({why}): no robot declared completion", traversals]
     if "radio_range_m" in result:
-        radio = [f"radio {result['radio_range_m']:g} m, connectivity {result['connectivity']}: "
-                 f"{result['messages']} messages, {result['relay_trips']} relay trips; every "
-                 f"robot reached the base in {100 * result['connected_share']:.1f} % of the "
-                 f"ticks, the team with the base was biconnected in "
-                 f"{100 * result['biconnected_share']:.1f} %"]
-    if not result["completed"]:
-        why = result.get("reason") or result.get("ended_because", "max time")
-        lines = [head, f"not completed ({why}): no robot declared completion", *radio]
-        lines += [f"stopped: R{s['robot']} at {s['at_s']:.1f} s: {s['reason']}"
-                  for s in result.get("stopped_robots", [])]
-        return "\n".join(lines)
-    per_robot = " ".join(f"R{i + 1}={n}" for i, n in enumerate(result["traversals_per_robot"]))
-    verdict = "equal to" if result["map_correct"] else "DIFFERENT from"
-    unit = "edges (most by any robot)" if result["world"] == "embodied" else "steps"
-    lines = [
-        head,
-        f"completed: R{result['declared_by']} declared completion at {result['declared_at']}; "
-        f"makespan {result['makespan']:g} {unit}",
-        f"traversals: {result['total_traversals']} in total ({per_robot})",
-        f"map: {len(result['map_edges'])} edges, {verdict} the arena's",
-        *radio,
-    ]
+        lines.append(
+            f"radio {result['radio_range_m']:g} m, connectivity {result['connectivity']}: "
+            f"{result['messages']} messages, {result['relay_trips']} relay trips; every "
+            f"robot reached the base in {100 * result['connected_share']:.1f} % of the "
+            f"ticks, the team with the base was biconnected in "
+            f"{100 * result['biconnected_share']:.1f} %")
     if result["world"] == "embodied":
-        lines += [
-            (f"physics: {result['sim_time_s']:.1f} s simulated in {result['wall_time_s']:.1f} s "
-            f"({result['realtime_factor']:.1f}x real time)"),
-            (f"collisions: {result['collisions']} robot-robot contact events; "
-            f"speed changes (eq. 27): {result['speed_changes']}"),
-            f"vertex entry: {result['station_messages']} messages with the stations",
-        ]
-        lines += [f"stopped: R{s['robot']} at {s['at_s']:.1f} s: {s['reason']}"
-                  for s in result["stopped_robots"]]
-        lines += [f"fault: {f['fault']} at {f['at_s']:.1f} s" for f in result["faults"]]
-        if result["connectivity"] != "none":
-            lines.append(
-                f"connectivity {result['connectivity']}: every robot reached the base in "
-                f"{100 * result['connected_share']:.1f} % of the ticks ({result['cut_ticks']} "
-                f"cut), biconnected in {100 * result['biconnected_share']:.1f} %")
-        if result["radio_messages"] is not None:
-            agreement = result["radio_belief_agreement"]
-            lines.append(
-                f"radio: {result['radio_messages']} messages (busiest robot "
-                f"{result['radio_max_messages_per_robot']})" + (
-                    "" if agreement is None  # no connectivity tables in tethered runs
-                    else f"; beliefs matched the truth in {100 * agreement:.1f} % of samples"))
-        if result["recording"]:
-            lines.append(f"recording: {result['recording']}")
-        if result["video"]:
-            lines.append(f"video: {result['video']}")
+        lines += _embodied_lines(result)
     return "\n".join(lines)
+
+
+def per_robot(counts: list[int], listed: int = SUMMARY_ROBOTS) -> str:
+    """``R1=5 R2=3 ...``, or for a team larger than ``listed`` the spread."""
+    if len(counts) <= listed:
+        return " ".join(f"R{i + 1}={n}" for i, n in enumerate(counts))
+    return (f"R1..R{len(counts)}: {min(counts)} to {max(counts)} each, "
+            f"mean {sum(counts) / len(counts):.1f}")
+
+
+def _embodied_lines(result: dict) -> list[str]:
+    """The summary lines of the physics: time, contacts, stops, faults, radio, outputs."""
+    end = result["sim_time_s"]
+    lines = [
+        (f"physics: {end:.1f} s simulated in {result['wall_time_s']:.1f} s "
+         f"({result['realtime_factor']:.1f}x real time)"),
+        (f"collisions: {result['collisions']} robot-robot contact events; "
+         f"speed changes (eq. 27): {result['speed_changes']}"),
+        f"vertex entry: {result['station_messages']} messages with the stations",
+    ]
+    lines += [f"stopped: R{s['robot']} at {s['at_s']:.1f} s: {s['reason']}"
+              for s in result["stopped_robots"]]
+    lines += [f"fault: {f['fault']} at {f['at_s']:.1f} s" if f["fired"] else
+              f"fault: {f['fault']} not fired (the run ended at {end:.1f} s)"
+              for f in result["faults"]]
+    if result["connectivity"] != "none" and result["connected_share"] is not None:
+        lines.append(
+            f"connectivity {result['connectivity']}: every robot reached the base in "
+            f"{100 * result['connected_share']:.1f} % of the ticks ({result['cut_ticks']} "
+            f"cut), biconnected in {100 * result['biconnected_share']:.1f} %")
+    if result["radio_messages"] is not None:
+        agreement = result["radio_belief_agreement"]
+        lines.append(
+            f"radio: {result['radio_messages']} messages (busiest robot "
+            f"{result['radio_max_messages_per_robot']})" + (
+                "" if agreement is None  # no connectivity tables in tethered runs
+                else f"; beliefs matched the truth in {100 * agreement:.1f} % of samples"))
+    if result["recording"]:
+        lines.append(f"recording: {result['recording']}")
+    if result["video"]:
+        lines.append(f"video: {result['video']}")
+    return lines

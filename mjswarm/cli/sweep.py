@@ -75,11 +75,14 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
+    from mjswarm.cli import check_seeds
     from mjswarm.outputs.sweep import ResultsFile, grid, sweep
 
+    seeds = _ints(args.seeds, "--seeds")
+    check_seeds(seeds, "--seeds")
     cells = grid(args.world, [a for a in args.arenas.split(",") if a],
                  _ints(args.robots, "--robots"), [s for s in args.strategies.split(",") if s],
-                 _ints(args.seeds, "--seeds"), _floats(args.radio_ranges, "--radio-ranges"),
+                 seeds, _floats(args.radio_ranges, "--radio-ranges"),
                  [c for c in args.connectivity.split(",") if c])
     done = ResultsFile(args.out).done()
     bar = tqdm(total=len(cells), initial=sum(c.key in done for c in cells), unit="run",

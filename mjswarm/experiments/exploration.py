@@ -93,8 +93,9 @@ from mjswarm.arena.geometry import LANE_OFFSET_M, VERTEX_CLEAR_RADIUS_M
 from mjswarm.experiments.awareness import BICONNECTED, NOT, sight_blocker
 from mjswarm.experiments.awareness import truth as awareness_truth
 from mjswarm.core.bearing import BearingSensor
-from mjswarm.errors import MjswarmError
-from mjswarm.experiments.faults import Fault
+from mjswarm.core.robot import spark_v_geometry
+from mjswarm.errors import MjswarmError, RunInterrupted
+from mjswarm.experiments.faults import Fault, check_fault, is_user_fault
 from mjswarm.worlds.graphworld import ExplorationResult, make_minds, outcome
 from mjswarm.worlds.radiograph import CONNECTIVITY, NEED, infeasible_reason, need_robots
 from mjswarm.outputs.recording import contact_event
@@ -198,14 +199,17 @@ class EmbodiedResult(ExplorationResult):
     sim_time_s: float = 0.0
     wall_time_s: float = 0.0
     realtime_factor: float = 0.0
-    #: why the run ended: "completed", "stalled", "all robots stopped" or "max time"
+    #: why the run ended: "completed", "stalled", "all robots stopped", "max time",
+    #: "interrupted" (Ctrl-C; what was measured until then) or the infeasibility verdict
     ended_because: str = ""
     #: robots that stopped for good: ``{"robot": R, "reason": ..., "at_s": t}``
     stopped_robots: list[dict] = field(default_factory=list)
     #: largest |odometry heading - true heading| of any robot over the run (deg), on lanes
     #: and at vertex calls
     heading_error_deg: float = 0.0
-    #: injected faults and when they took effect: ``{"fault": text, "at_s": t}``
+    #: injected faults and when they took effect: ``{"fault": text, "fired": True,
+    #: "at_s": t}``; a fault whose time the run did not reach has ``"fired": False`` and
+    #: ``"at_s": None``
     faults: list[dict] = field(default_factory=list)
     #: with a radio: messages sent in all, by the busiest robot, and the share of sampled
     #: robot beliefs ("biconnected" or not) that equalled the truth
@@ -246,7 +250,9 @@ class EmbodiedExploration(LoopFunctions):
     """One embodied exploration run: build the world and the robots, run, measure."""
 
     def __init__(self, spec: ArenaSpec, minds: list[Strategy], config: EmbodiedConfig,
-                 seed: int | None = None, recorder=None) -> None:
+                 seed: int | None = None, recorder=None, progress: bool = False) -> None:
+        """Check every parameter, then build the world (``progress``: say on stderr what
+        is being built, and how long it took: a thousand robots take seconds)."""
         k = len(minds)
         if config.speed_m_s <= 0:
             raise MjswarmError(f"speed must be positive, got {config.speed_m_s} m/s")
@@ -268,7 +274,17 @@ class EmbodiedExploration(LoopFunctions):
             raise MjswarmError(f"connectivity {config.connectivity} needs a radio range")
         need_robots(config.connectivity, k)
         self.spec, self.minds, self.config, self.seed = spec, minds, config, seed
+        for fault in config.faults:
+            check_fault(fault, self)
+        top = spark_v_geometry().max_speed_m_s
+        if config.speed_m_s > top:
+            raise MjswarmError(f"speed {config.speed_m_s} m/s exceeds the robot's top speed "
+                               f"{top:.2f} m/s")
         self.recorder = recorder
+        if progress:
+            print(f"explore: building {spec.name} with {k} robot(s) ...", file=sys.stderr,
+                  flush=True)
+        built = time.perf_counter()
         xs = [x for x, _ in spec.vertices.values()]
         ys = [y for _, y in spec.vertices.values()]
         depot = [Pose2D(min(xs) + DEPOT_SPACING_M * i, min(ys) - DEPOT_OFFSET_M, 0.0)
@@ -277,10 +293,6 @@ class EmbodiedExploration(LoopFunctions):
                               line_noise_m=config.line_noise_m, ir_noise_m=config.ir_noise_m,
                               wheel_slip=config.wheel_slip, physics=config.physics)
         geometry = self.sim.geometry
-        if geometry.max_speed_m_s < config.speed_m_s:
-            raise MjswarmError(
-                f"speed {config.speed_m_s} m/s exceeds the robot's top speed "
-                f"{geometry.max_speed_m_s:.2f} m/s")
         bearing = BearingSensor(
             self.sim, math.radians(config.bearing_fov_deg), config.bearing_range_m,
             math.radians(config.bearing_noise_deg), seed=seed or 0)
@@ -354,9 +366,9 @@ class EmbodiedExploration(LoopFunctions):
         self._vertices = np.array(list(spec.vertices.values()))
         self._vertex_ids = list(spec.vertices)
         self._nearest_version = -1  # _nearest_vertex's cache
-        for fault in config.faults:
-            fault.check(self)
         self.loop = Loop(self.world, dict(enumerate(self.robots)), [self])
+        if progress:
+            print(f"explore: built in {time.perf_counter() - built:.1f} s", file=sys.stderr)
 
     @property
     def active(self) -> list[bool]:
@@ -384,18 +396,26 @@ class EmbodiedExploration(LoopFunctions):
                    disable=not (progress and sys.stderr.isatty()))
         log = progress and bar.disable
         shown = 0
-        for _ in range(ticks):
-            self.step()
-            if self.loop.stopped:  # should_stop: finished() said why
-                break
-            now = int(self.sim.time_s)
-            if now > shown:
-                bar.update(now - shown)
-                shown = now
-                bar.set_postfix(edges=self._traversals(), refresh=False)
-            if log and time.perf_counter() - last_status >= STATUS_EVERY_S:
-                last_status = time.perf_counter()
-                print(self._status(last_status - start), file=sys.stderr, flush=True)
+        try:
+            for _ in range(ticks):
+                self.step()
+                if self.loop.stopped:  # should_stop: finished() said why
+                    break
+                now = int(self.sim.time_s)
+                if now > shown:
+                    bar.update(now - shown)
+                    shown = now
+                    bar.set_postfix(edges=self._traversals(), refresh=False)
+                if log and time.perf_counter() - last_status >= STATUS_EVERY_S:
+                    last_status = time.perf_counter()
+                    print(self._status(last_status - start), file=sys.stderr, flush=True)
+        except KeyboardInterrupt:
+            self.ended_because = "interrupted"
+            raise RunInterrupted(self._end(bar, log, start)) from None
+        return self._end(bar, log, start)
+
+    def _end(self, bar: tqdm, log: bool, start: float) -> EmbodiedResult:
+        """Close the progress display, mark the end in the recording, and the result."""
         bar.close()
         self._event(None, f"run ended: {self.ended_because}")
         if log:
@@ -690,7 +710,8 @@ class EmbodiedExploration(LoopFunctions):
         while self.pending_faults and self.pending_faults[0].at_s <= now:
             fault = self.pending_faults.pop(0)
             fault.apply(self)
-            self.fault_log.append({"fault": str(fault), "at_s": round(self.sim.time_s, 2)})
+            self.fault_log.append({"fault": str(fault), "fired": True,
+                                   "at_s": round(self.sim.time_s, 2)})
             self._event(None, f"fault: {fault}")
 
     def _record_vertex_call(self, i: int, vertex: str, beacon: Beacon) -> None:
@@ -772,7 +793,8 @@ class EmbodiedExploration(LoopFunctions):
             ended_because=self.ended_because,
             stopped_robots=list(self.stopped),
             heading_error_deg=round(math.degrees(self.heading_error_rad), 3),
-            faults=list(self.fault_log),
+            faults=[*self.fault_log, *({"fault": str(f), "fired": False, "at_s": None}
+                                       for f in self.pending_faults if is_user_fault(f))],
         )
 
 

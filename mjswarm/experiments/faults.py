@@ -120,6 +120,23 @@ _PATTERNS = (
 )
 
 
+def check_fault(fault: Fault, run: EmbodiedExploration) -> None:
+    """Refuse, in one line, a fault that does not fit ``run``: one that can never fire
+    (its time is past the run's ``max_sim_time_s``) or whose target is not there. A fault
+    whose time the run does not reach because the run ended earlier is reported as not
+    fired in the result instead."""
+    end_s = run.config.max_sim_time_s
+    if fault.at_s >= end_s:
+        raise MjswarmError(f"fault {fault} can never fire: the run ends at {end_s:g} s "
+                           "(--max-time)")
+    fault.check(run)
+
+
+def is_user_fault(fault) -> bool:
+    """Whether ``fault`` was asked for (not one a fault scheduled, as a blackout's end)."""
+    return not isinstance(fault, _BlackoutEnd)
+
+
 def parse_fault(text: str) -> Fault:
     """One ``--fault`` value; :class:`MjswarmError` naming the forms if it is none of them."""
     for pattern, build in _PATTERNS:

@@ -24,14 +24,13 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from mjswarm.errors import MjswarmError
+from mjswarm.worlds.graphworld import MAX_ROBOTS
 
 WORLDS = ("graph", "embodied")
 BACKENDS = ("local", "ray")
 CELL_KEYS = ("world", "arena", "robots", "strategy", "seed", "radio_range_m", "connectivity")
 #: What a results file written before radio ranges and constraints existed holds.
 CELL_DEFAULTS = {"radio_range_m": None, "connectivity": "none"}
-#: Largest team a sweep runs (the benchmark's largest; beyond it a run takes hours).
-MAX_ROBOTS = 1000
 
 
 @dataclass(frozen=True)

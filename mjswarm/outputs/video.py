@@ -37,6 +37,7 @@ import imageio_ffmpeg
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
+import mjswarm
 from mjswarm.errors import MjswarmError, one_line
 from mjswarm.outputs.recording import robot_color
 from mjswarm.worlds.loop import Loop, LoopFunctions
@@ -88,6 +89,9 @@ class MujocoCamera:
                 warnings.simplefilter("ignore")
                 self.renderer = mujoco.Renderer(model, height, width, max_geom=20_000)
         except Exception as exc:  # noqa: BLE001 - any GL failure is the same to the user
+            if mjswarm.GL_PROBLEM:  # switched off so that mujoco imports (see mjswarm)
+                raise MjswarmError(f"cannot render video: {mjswarm.GL_PROBLEM}; set "
+                                   "MUJOCO_GL=egl (Mesa's headless EGL) or unset it") from None
             backend = os.environ.get("MUJOCO_GL", "(default)")
             raise MjswarmError(f"cannot render video: no working OpenGL backend "
                                f"(MUJOCO_GL={backend}; MuJoCo reads it when first imported, "
