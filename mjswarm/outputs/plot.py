@@ -3,7 +3,7 @@
 From a recording (``.rrd``, any run recorded with ``--record``): the arena when there is
 one (the lines on the floor, the walls, the vertices with their names above everything
 else), every robot's trajectory in its recording colour ending in a dot (a robot that
-never left the depot is still in the legend, as such), the radio links at the end (blue,
+did not move, or never left the depot, is in the legend as such), the radio links at the end (blue,
 dashed) when the robots had radios, where completion was declared (a star), contact
 events (red crosses) and a table of headline figures read from the recording (robots,
 simulated time, how the run ended, distance driven, contacts, completion). An arena
@@ -41,6 +41,7 @@ from mjswarm.outputs.recording import CONTACT_PATTERN, robot_color  # noqa: E402
 PARKED_M = 0.02
 _DECLARED = re.compile(r"(R\d+) declared completion at (\S+)")
 _ENDED = re.compile(r"^run ended: (.+)$")
+_LAUNCHED = re.compile(r"^(R\d+) launched at ")
 #: Colours of the floor's lines and of the walls.
 LINE_COLOR, WALL_COLOR = "0.55", "saddlebrown"
 #: Vertex names: above every line and mark, offset up and right from the centre (points).
@@ -138,6 +139,7 @@ def plot_recording(path: str | Path, out: str | Path, fmt: str = "png") -> None:
         ax.plot([], [], color="tab:blue", linestyle="--", linewidth=0.8,
                 label="radio link at the end")
     driven = {}
+    launched = {m.group(1) for _, text in trace.events if (m := _LAUNCHED.match(text))}
     for robot, (_, xy) in sorted(trace.paths.items(), key=lambda kv: _robot_index(kv[0])):
         moved = np.linalg.norm(np.diff(xy, axis=0), axis=1)
         keep = np.concatenate([[True], moved < 1.0])  # a launch from the depot is a jump
@@ -149,8 +151,10 @@ def plot_recording(path: str | Path, out: str | Path, fmt: str = "png") -> None:
             ax.plot(seg[:, 0], seg[:, 1], color=color, linewidth=1.3, zorder=3)
         if segments:
             ax.plot(*segments[-1][-1], marker="o", color=color, markersize=6, zorder=4)
+        still = ("never left the depot" if trace.vertices and robot not in launched
+                 else "did not move")
         ax.plot([], [], color=color, linewidth=1.3,
-                label=robot if segments else f"{robot} (never left the depot)")
+                label=robot if segments else f"{robot} ({still})")
     ax.plot([], [], marker="o", color="0.3", linestyle="none", markersize=6,
             label="where a robot was last")
     contacts = [m for _, text in trace.events if (m := CONTACT_PATTERN.search(text))]
