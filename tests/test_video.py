@@ -14,8 +14,8 @@ import pytest
 import rerun as rr
 
 from mjswarm.cli import main
-from mjswarm.outputs.recording import rerun_command
-from mjswarm.outputs.video import FPS, HEIGHT_PX, WIDTH_PX
+from mjswarm.outputs.recording import rerun_command, robot_color
+from mjswarm.outputs.video import FPS, HEIGHT_PX, LINK_RGB, MARK_RGBA, WIDTH_PX
 
 SECONDS = 20.0
 SPEEDUP = 10.0
@@ -134,3 +134,32 @@ def test_coverage_and_patrol_results_are_pictured(tmp_path, capsys, argv):
     assert main([*argv, "--json", str(result)]) == 0
     assert main(["plot", str(result), "-o", str(out)]) == 0
     assert out.read_bytes().startswith(b"%PDF") and out.stat().st_size > 5_000
+
+
+def near(frame, rgb, tolerance=40):
+    """Where ``frame`` (H, W, 3) has colour ``rgb`` (after H.264's blur)."""
+    return (np.abs(frame.astype(int) - np.array(rgb[:3])).sum(axis=2) < tolerance)
+
+
+def test_the_legend_names_every_robot_and_the_depot_at_the_start(filmed_run):
+    """At t = 0 only R1 is on the floor; the legend (top right) still shows R1's and
+    R2's colours, and dark text beside them."""
+    video, _, _ = filmed_run
+    first = frames(video)[0]
+    legend = first[24:140, 400:]
+    for i in range(2):
+        assert near(legend, robot_color(i)).sum() > 20, f"R{i + 1} not in the legend"
+    assert (legend.sum(axis=2) < 150).sum() > 100  # its text
+    assert near(legend, [int(255 * c) for c in MARK_RGBA]).sum() > 20  # the beacon's entry
+
+
+def test_the_patrol_video_names_roles_target_and_links(tmp_path, capsys):
+    video = tmp_path / "patrol.mp4"
+    assert main(["experiment", "patrol", "--world", "point", "--robots", "4", "--steps", "40",
+                 "--video", str(video)]) == 0
+    last = frames(video)[-1]
+    legend = last[24:200, 440:]
+    assert near(legend, LINK_RGB).sum() > 10  # the radio link's entry
+    for i in range(4):
+        assert near(legend, robot_color(i)).sum() > 20, f"R{i + 1} not in the legend"
+    assert near(last[:, :440], LINK_RGB).sum() > 10  # links drawn on the floor

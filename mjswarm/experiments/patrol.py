@@ -305,7 +305,7 @@ def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
         mission.recording = Recording(recorder)
         functions.append(mission.recording)
     if video is not None:
-        functions.append(video)
+        functions.append(_shows_mission(video, minds, floor, params.d_c))
     loop = Loop(floor, dict(enumerate(timed)), functions)
     loop.run(max_ticks=steps)
     robot_steps = robots * steps
@@ -339,6 +339,19 @@ def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
         wall_s=time.perf_counter() - started,
         history=mission.history if keep_history else {},
     )
+
+
+def _shows_mission(video: Video, minds: list[RoleSwitchingRobot], floor: MotionWorld,
+                   d_c: float) -> Video:
+    """``video``, told to show the base station's target, the network's links (mutual
+    connections no longer than ``d_c``, m) and each robot's role."""
+    def links():
+        xy = floor.true_positions()
+        return [(xy[a], xy[b]) for a, b in network_graph(minds, xy, d_c).edges]
+
+    video.marks, video.marks_label = (lambda: [minds[0].target.x]), "target (of the leader)"
+    video.links, video.notes = links, (lambda: [m.role.value for m in minds])
+    return video
 
 
 def summarize(trials: list[TrialResult]) -> dict:

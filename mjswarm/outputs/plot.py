@@ -1,22 +1,27 @@
 """A summary picture of any run (issue 15): ``mjswarm plot RESULT -o OUT.png``.
 
-From a recording (``.rrd``, any run recorded with ``--record``): the arena's strips and
-vertices when there is an arena, every robot's trajectory in its recording colour, the
-radio links at the end (blue, dashed) when the robots had radios, where completion was
-declared (a star), contact events (red crosses) and a table of headline figures read
-from the recording (robots, simulated time, distance driven, contacts, completion).
+From a recording (``.rrd``, any run recorded with ``--record``): the arena when there is
+one (the lines on the floor, the walls, the vertices with their names above everything
+else), every robot's trajectory in its recording colour ending in a dot (a robot that
+did not move, or never left the depot, is in the legend as such), the radio links at the end (blue,
+dashed) when the robots had radios, where completion was declared (a star), contact
+events (red crosses) and a table of headline figures read from the recording (robots,
+simulated time, how the run ended, distance driven, contacts, completion). An arena
+run's recording without its "run ended" event (an interrupted run) is titled partial.
 
 From a ``--json`` result: an exploration run draws the arena's graph and each robot's
 vertex-to-vertex path (the result holds paths, not trajectories; record the run for
-those) with the declaring robot's vertex; a coverage run its S-coverage per episode
-against the paper's mean; a patrol run its headline figures. The format follows the
-output file's extension (PNG, SVG, PDF: matplotlib's).
+those) with the declaring robot's vertex, and lists each robot's vertices in visit
+order; a coverage run its S-coverage per episode against the paper's mean; a patrol run
+its headline figures. The format follows the output file's extension (PNG, SVG, PDF:
+matplotlib's).
 """
 
 from __future__ import annotations
 
 import json
 import re
+import textwrap
 from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +40,14 @@ from mjswarm.outputs.recording import CONTACT_PATTERN, robot_color  # noqa: E402
 #: A stretch of trajectory that spans less than this (m) is a robot parked in a depot.
 PARKED_M = 0.02
 _DECLARED = re.compile(r"(R\d+) declared completion at (\S+)")
+_ENDED = re.compile(r"^run ended: (.+)$")
+_LAUNCHED = re.compile(r"^(R\d+) launched at ")
+#: Colours of the floor's lines and of the walls.
+LINE_COLOR, WALL_COLOR = "0.55", "saddlebrown"
+#: Vertex names: above every line and mark, offset up and right from the centre (points).
+LABEL_STYLE = dict(fontsize=7, color="0.2", textcoords="offset points", xytext=(5, 5),
+                   zorder=8, bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none",
+                                       alpha=0.8))
 _ROBOT_POSE = re.compile(r"^/robots/(R\d+)/pose$")
 
 
@@ -46,6 +59,7 @@ class Trace:
     paths: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)  # t, xy
     vertices: dict[str, tuple[float, float]] = field(default_factory=dict)
     strips: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)  # segments
+    walls: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)  # segments
     links: list[np.ndarray] = field(default_factory=list)  # radio links at the end
     events: list[tuple[float, str]] = field(default_factory=list)
 
@@ -77,6 +91,8 @@ def read_recording(path: str | Path) -> Trace:
             trace.vertices = {v: (p[0], p[1]) for v, p in zip(labels, points)}
         elif entity == "/arena/strips" and "Boxes3D:centers" in columns:
             trace.strips = _segments(columns)
+        elif entity == "/arena/walls" and "Boxes3D:centers" in columns:
+            trace.walls = _segments(columns)
         elif entity == "/radio/links" and times is not None:
             for t, strips in zip(times, columns["LineStrips3D:strips"].to_pylist()):
                 if t >= last_links[0]:
@@ -96,7 +112,8 @@ def read_recording(path: str | Path) -> Trace:
 
 
 def _segments(columns) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Floor strips as segments: each box's long axis, turned by its quaternion."""
+    """Floor strips or walls as segments: each box's long axis, turned by its
+    quaternion."""
     centers = np.array(columns["Boxes3D:centers"].to_pylist()[0])
     halves = np.array(columns["Boxes3D:half_sizes"].to_pylist()[0])
     quats = np.array(columns["Boxes3D:quaternions"].to_pylist()[0])  # x, y, z, w
@@ -114,14 +131,15 @@ def plot_recording(path: str | Path, out: str | Path, fmt: str = "png") -> None:
     trace = read_recording(path)
     fig, (ax, table_ax) = plt.subplots(1, 2, figsize=(11, 6),
                                        gridspec_kw={"width_ratios": [3, 1.3]})
-    for a, b in trace.strips:
-        ax.plot([a[0], b[0]], [a[1], b[1]], color="0.75", linewidth=1, zorder=1)
-    for v, (x, y) in trace.vertices.items():
-        ax.annotate(v, (x, y), fontsize=7, color="0.35", ha="center", va="bottom")
+    _draw_arena(ax, trace)
     for link in trace.links:
         ax.plot(link[:, 0], link[:, 1], color="tab:blue", linestyle="--", linewidth=0.8,
                 zorder=2)
+    if trace.links:
+        ax.plot([], [], color="tab:blue", linestyle="--", linewidth=0.8,
+                label="radio link at the end")
     driven = {}
+    launched = {m.group(1) for _, text in trace.events if (m := _LAUNCHED.match(text))}
     for robot, (_, xy) in sorted(trace.paths.items(), key=lambda kv: _robot_index(kv[0])):
         moved = np.linalg.norm(np.diff(xy, axis=0), axis=1)
         keep = np.concatenate([[True], moved < 1.0])  # a launch from the depot is a jump
@@ -129,11 +147,16 @@ def plot_recording(path: str | Path, out: str | Path, fmt: str = "png") -> None:
         color = np.array(robot_color(_robot_index(robot))) / 255.0
         segments = [seg for seg in np.split(xy, np.flatnonzero(~keep))
                     if np.ptp(seg, axis=0).max() > PARKED_M]  # not the depot
-        for k, seg in enumerate(segments):
-            ax.plot(seg[:, 0], seg[:, 1], color=color, linewidth=1.3, zorder=3,
-                    label=robot if k == len(segments) - 1 else None)
+        for seg in segments:
+            ax.plot(seg[:, 0], seg[:, 1], color=color, linewidth=1.3, zorder=3)
         if segments:
             ax.plot(*segments[-1][-1], marker="o", color=color, markersize=6, zorder=4)
+        still = ("never left the depot" if trace.vertices and robot not in launched
+                 else "did not move")
+        ax.plot([], [], color=color, linewidth=1.3,
+                label=robot if segments else f"{robot} ({still})")
+    ax.plot([], [], marker="o", color="0.3", linestyle="none", markersize=6,
+            label="where a robot was last")
     contacts = [m for _, text in trace.events if (m := CONTACT_PATTERN.search(text))]
     if contacts:
         ax.scatter([float(m.group(3)) for m in contacts], [float(m.group(4)) for m in contacts],
@@ -142,10 +165,15 @@ def plot_recording(path: str | Path, out: str | Path, fmt: str = "png") -> None:
     if declared and declared[0][1].group(2) in trace.vertices:
         ax.scatter(*trace.vertices[declared[0][1].group(2)], marker="*", s=260,
                    color="gold", edgecolor="black", zorder=6, label="completion declared")
-    _frame(ax, trace)
+    ended = [m.group(1) for _, text in trace.events if (m := _ENDED.search(text))]
+    partial = bool(trace.vertices) and ended[-1:] in ([], ["interrupted"])
+    _frame(ax, f"{trace.name}: trajectories (ground truth)"
+               + (", PARTIAL: the run was interrupted" if partial else ""))
     end = max(t[-1] for t, _ in trace.paths.values())
-    rows = [("robots", str(len(trace.paths))), ("simulated time", f"{end:.1f} s"),
-            ("contact events", str(len(contacts)))]
+    rows = [("robots", str(len(trace.paths))), ("simulated time", f"{end:.1f} s")]
+    if trace.vertices:
+        rows.append(("run ended", ended[-1] if ended else "not recorded (partial)"))
+    rows.append(("contact events", str(len(contacts))))
     if declared:
         t, m = declared[0]
         rows.append(("completion", f"{m.group(1)} at {m.group(2)}, {t:.1f} s"))
@@ -155,19 +183,38 @@ def plot_recording(path: str | Path, out: str | Path, fmt: str = "png") -> None:
     _save(fig, out, fmt)
 
 
-def _frame(ax, trace: Trace) -> None:
+def _draw_arena(ax, trace: Trace) -> None:
+    """The floor's lines, the walls and the named vertices (each in the legend)."""
+    for segments, color, width, label in ((trace.strips, LINE_COLOR, 1.5, "line on the floor"),
+                                          (trace.walls, WALL_COLOR, 2.5, "wall")):
+        for k, (a, b) in enumerate(segments):
+            ax.plot([a[0], b[0]], [a[1], b[1]], color=color, linewidth=width, zorder=1,
+                    solid_capstyle="butt", label=None if k else label)
+    _draw_vertices(ax, trace.vertices)
+
+
+def _draw_vertices(ax, vertices: dict[str, tuple[float, float]]) -> None:
+    if not vertices:
+        return
+    xy = np.array(list(vertices.values()))
+    ax.scatter(xy[:, 0], xy[:, 1], s=14, color="white", edgecolor="0.2", linewidth=0.8,
+               zorder=7, label="vertex")
+    for v, (x, y) in vertices.items():
+        ax.annotate(v, (x, y), **LABEL_STYLE)
+
+
+def _frame(ax, title: str) -> None:
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.grid(True, linewidth=0.3)
-    ax.legend(fontsize=7, loc="best", ncol=2)
-    ax.set_title(f"{trace.name}: trajectories (ground truth)")
+    ax.legend(fontsize=7, loc="best", ncol=2, framealpha=0.9)
+    ax.set_title(title)
 
 
 def _table(ax, rows: list[tuple[str, str]], title: str) -> None:
     ax.axis("off")
-    table = ax.table(cellText=[[a, b] for a, b in rows], colLabels=["figure", "value"],
-                     loc="upper center", cellLoc="left", colLoc="left")
+    table = ax.table(cellText=[[a, b] for a, b in rows], loc="upper center", cellLoc="left")
     table.auto_set_font_size(False)
     table.set_fontsize(8)
     table.scale(1.0, 1.3)
@@ -206,11 +253,11 @@ def _plot_exploration(data: dict, out, fmt: str) -> None:
     spec = load_arena(data["arena"])
     fig, (ax, table_ax) = plt.subplots(1, 2, figsize=(11, 6),
                                        gridspec_kw={"width_ratios": [3, 1.3]})
-    for u, v in spec.edges:
+    for n, (u, v) in enumerate(spec.edges):
         (x0, y0), (x1, y1) = spec.vertices[u], spec.vertices[v]
-        ax.plot([x0, x1], [y0, y1], color="0.75", linewidth=2, zorder=1)
-    for v, (x, y) in spec.vertices.items():
-        ax.annotate(v, (x, y), fontsize=7, color="0.35", ha="center", va="bottom")
+        ax.plot([x0, x1], [y0, y1], color="0.75", linewidth=2, zorder=1,
+                label=None if n else "edge")
+    _draw_vertices(ax, spec.vertices)
     k = len(data["paths"])
     for i, path in enumerate(data["paths"]):
         shift = 0.03 * (i - (k - 1) / 2)  # side by side where robots share an edge
@@ -220,20 +267,24 @@ def _plot_exploration(data: dict, out, fmt: str) -> None:
     if data.get("declared_at") in spec.vertices:
         ax.scatter(*spec.vertices[data["declared_at"]], marker="*", s=260, color="gold",
                    edgecolor="black", zorder=6, label="completion declared")
-    trace = Trace(name=f"{data['arena']}, {k} robots, {data.get('world', '')} world")
-    _frame(ax, trace)
-    ax.set_title(f"{trace.name}: vertex paths")
-    rows = [("completed", str(data.get("completed"))),
-            ("makespan", str(data.get("makespan"))),
-            ("traversals", str(data.get("total_traversals"))),
-            ("map correct", str(data.get("map_correct")))]
+    name = f"{data['arena']}, {k} robots, {data.get('world', '')} world"
+    _frame(ax, f"{name}: vertex paths")
+    rows = [("completed", "yes" if data.get("completed") else "no"),
+            ("makespan (steps)", str(data.get("makespan"))),
+            ("edge traversals", str(data.get("total_traversals"))),
+            ("map correct", "yes" if data.get("map_correct") else "no")]
     for key, label, unit in (("collisions", "contact events", ""),
                              ("sim_time_s", "simulated time", " s")):
         if data.get(key) is not None:
             value = data[key]
             rows.append((label, f"{value:.1f}{unit}" if isinstance(value, float) else
                          f"{value}{unit}"))
-    _table(table_ax, rows, "seed 003's metrics")
+    _table(table_ax, rows, name)
+    order = "\n".join(textwrap.fill(f"R{i + 1}: " + " ".join(path), 44,
+                                     subsequent_indent="     ")
+                       for i, path in enumerate(data["paths"]))
+    table_ax.text(0.0, 0.55, "vertices in visit order\n" + order, fontsize=7, va="top",
+                  family="monospace", transform=table_ax.transAxes)
     _save(fig, out, fmt)
 
 

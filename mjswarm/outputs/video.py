@@ -20,8 +20,13 @@ Two cameras, one look:
   the same colours, discs of the Spark V's size with a heading tick.
 
 Both draw each robot's trail (its positions at the last ``TRAIL_FRAMES`` frames) and the
-marks the loop functions give (e.g. vertices whose beacon has been dropped), and the
-simulated time is written on every frame.
+marks the loop functions give (e.g. vertices whose beacon has been dropped). Each camera
+maps floor points to pixels (``to_pixels``), so every frame is then written over the same
+way, to read without the README: the title and simulated time; radio links (when given);
+vertex names (the arena's, from the MuJoCo model); each robot's name, and its note (e.g.
+its role) when given, beside it; a scale bar on the floor; and a legend: each robot's
+colour and name (robots off the floor are listed as "in depot" or "docked at base"),
+the marks and the links.
 """
 
 from __future__ import annotations
@@ -39,7 +44,7 @@ from PIL import Image, ImageDraw, ImageFont
 
 import mjswarm
 from mjswarm.errors import MjswarmError, one_line
-from mjswarm.outputs.recording import robot_color
+from mjswarm.outputs.recording import robot_color, robot_name
 from mjswarm.worlds.loop import Loop, LoopFunctions
 
 #: Frames per second of video.
@@ -59,11 +64,27 @@ TRAIL_FRAMES = 90
 #: Height of trails and marks above the floor (m).
 OVERLAY_Z_M = 0.006
 MARK_RGBA = (0.95, 0.75, 0.1, 1.0)
+#: Radius of a mark on the floor, as a fraction of the framed width (at least 4 cm).
+MARK_RADIUS = 0.015
+#: What the marks are unless the caller says: :mod:`mjswarm.cli.explore` marks the vertices
+#: whose beacon has been dropped.
+BEACON_LABEL = "beacon dropped (vertex explored)"
+#: Colour of radio links (RGB).
+LINK_RGB = (40, 90, 220)
+#: Height of the band at the top of every frame, which holds the title and time (pixels).
+TITLE_PX = 24
+#: Robots the legend lists by name; the rest are counted.
+LEGEND_ROBOTS = 12
+#: Lengths a scale bar may have (m); it takes the longest within a quarter of the framed
+#: width.
+SCALE_BARS_M = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0)
 #: Render passes the overview does without (each costs a pass of Mesa's software GL).
 NO_RENDER_FLAGS = ("mjRND_SHADOW", "mjRND_REFLECTION", "mjRND_SKYBOX")
 
 #: A frame-rendering function: poses (N, 3), trails (per robot an (M, 2) array, m),
-#: marks ((x, y) points, m) -> an RGB frame (H, W, 3) uint8.
+#: marks ((x, y) points, m) -> an RGB frame (H, W, 3) uint8; with ``to_pixels`` (floor
+#: points (M, 2) in m -> pixel columns and rows (M, 2)) and ``labels`` (name -> floor
+#: point, m: the places each frame names).
 Camera = Callable[[np.ndarray, Sequence[np.ndarray], Sequence[tuple[float, float]]], np.ndarray]
 
 
@@ -75,6 +96,8 @@ class MujocoCamera:
     def __init__(self, sim, bounds_m: Sequence[float], width: int = WIDTH_PX,
                  height: int = HEIGHT_PX) -> None:
         import mujoco
+
+        from mjswarm.arena.builder import VERTEX_SITE_PREFIX
 
         self._mujoco = mujoco
         self.sim = sim
@@ -101,6 +124,31 @@ class MujocoCamera:
         # rangefinder rays would be drawn as short yellow strokes, like the beacon marks
         self.option.flags[mujoco.mjtVisFlag.mjVIS_RANGEFINDER] = 0
         self.camera = _overview(mujoco.MjvCamera(), bounds_m, width / height)
+        self.mark_radius_m = max(0.04, MARK_RADIUS * (bounds_m[2] - bounds_m[0]))
+        self.size_px = (width, height)
+        mujoco.mj_forward(model, sim.data)
+        self.labels = {model.site(k).name.removeprefix(VERTEX_SITE_PREFIX):
+                       tuple(sim.data.site_xpos[k, :2]) for k in range(model.nsite)
+                       if model.site(k).name.startswith(VERTEX_SITE_PREFIX)}
+
+    def to_pixels(self, xy_m) -> np.ndarray:
+        """Pixel columns and rows of floor points (M, 2) (m): the free camera's
+        perspective (MuJoCo's: the eye ``distance`` behind ``lookat``, ``FOVY_DEG``)."""
+        c = self.camera
+        az, el = math.radians(c.azimuth), math.radians(c.elevation)
+        forward = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az),
+                            math.sin(el)])
+        up = np.array([-math.sin(el) * math.cos(az), -math.sin(el) * math.sin(az),
+                       math.cos(el)])
+        right = np.cross(forward, up)
+        xy = np.asarray(xy_m, float).reshape(-1, 2)
+        d = np.column_stack([xy, np.zeros(len(xy))]) - (np.array(c.lookat) - c.distance
+                                                         * forward)
+        width, height = self.size_px
+        focal = height / 2.0 / math.tan(math.radians(FOVY_DEG) / 2.0)
+        depth = d @ forward
+        return np.column_stack([width / 2.0 + focal * (d @ right) / depth,
+                                height / 2.0 - focal * (d @ up) / depth])
 
     def __call__(self, poses, trails, marks) -> np.ndarray:
         mujoco, r = self._mujoco, self.renderer
@@ -125,7 +173,7 @@ class MujocoCamera:
             if scene.ngeom >= scene.maxgeom:
                 break
             mujoco.mjv_initGeom(scene.geoms[scene.ngeom], mujoco.mjtGeom.mjGEOM_CYLINDER,
-                                np.array([0.04, 0.04, 0.002]),
+                                np.array([self.mark_radius_m, self.mark_radius_m, 0.002]),
                                 np.array([x, y, OVERLAY_Z_M]), eye,
                                 np.array(MARK_RGBA, np.float32))
             scene.ngeom += 1
@@ -164,10 +212,16 @@ class PlotCamera:
         self.radius_m = radius_m
         dpi = 100
         self.figure = plt.figure(figsize=(width / dpi, height / dpi), dpi=dpi)
-        self.axes = self.figure.add_axes((0.1, 0.1, 0.86, 0.8))
+        self.axes = self.figure.add_axes((0.08, 0.1, 0.6, 0.8))  # the legend goes right
         x0, y0, x1, y1 = bounds_m
         mx, my = (x1 - x0) * MARGIN + 0.2, (y1 - y0) * MARGIN + 0.2
         self.limits = (x0 - mx, x1 + mx, y0 - my, y1 + my)
+        self.labels: dict[str, tuple[float, float]] = {}
+
+    def to_pixels(self, xy_m) -> np.ndarray:
+        """Pixel columns and rows of floor points (M, 2) (m) on the last frame drawn."""
+        px = self.axes.transData.transform(np.asarray(xy_m, float).reshape(-1, 2))
+        return np.column_stack([px[:, 0], self.figure.bbox.height - px[:, 1]])
 
     def __call__(self, poses, trails, marks) -> np.ndarray:
         ax = self.axes
@@ -205,24 +259,31 @@ class Video(LoopFunctions):
         speedup: simulated seconds per second of video.
         fps: frames per second of video.
         marks: ``marks()`` gives the points (m) to mark on the next frame, or None.
+        marks_label: what the marks are, for the legend.
+        links: ``links()`` gives the radio links ((x, y), (x, y)) (m) to draw, or None.
+        notes: ``notes()`` gives a word per robot (e.g. its role) written after its name.
         title: written on every frame before the time.
     """
 
     def __init__(self, path: str | Path, bounds_m: Sequence[float],
                  speedup: float = DEFAULT_SPEEDUP, fps: int = FPS,
                  marks: Callable[[], Sequence[tuple[float, float]]] | None = None,
-                 title: str = "") -> None:
+                 title: str = "", marks_label: str = BEACON_LABEL,
+                 links: Callable[[], Sequence[Sequence[tuple[float, float]]]] | None = None,
+                 notes: Callable[[], Sequence[str]] | None = None) -> None:
         if not (math.isfinite(speedup) and speedup > 0):
             raise MjswarmError(f"video speed-up must be a positive number, got {speedup}")
         self.path, self.bounds_m, self.speedup, self.fps = Path(path), bounds_m, speedup, fps
         self.camera: Camera | None = None
-        self.marks, self.title = marks, title
+        self.marks, self.marks_label, self.title = marks, marks_label, title
+        self.links, self.notes = links, notes
         #: simulated time (s) of each frame drawn so far
         self.frame_times_s: list[float] = []
         self._next_s = 0.0
         self._trails: list[list[tuple[float, float]]] = []
         self._writer = None
         self._font = ImageFont.load_default(size=15)
+        self._small = ImageFont.load_default(size=12)
 
     @property
     def frame_interval_s(self) -> float:
@@ -250,10 +311,7 @@ class Video(LoopFunctions):
         marks = list(self.marks()) if self.marks is not None else []
         image = self.camera(poses, [np.array(t).reshape(-1, 2) for t in self._trails], marks)
         picture = Image.fromarray(image)
-        text = f"{self.title}  t = {world.time_s:7.1f} s  ({self.speedup:g}x)".strip()
-        draw = ImageDraw.Draw(picture)
-        draw.rectangle((0, 0, picture.width, 24), fill=(255, 255, 255))
-        draw.text((8, 4), text, fill=(0, 0, 0), font=self._font)
+        self._annotate(ImageDraw.Draw(picture), world, poses)
         frame = np.ascontiguousarray(np.asarray(picture))
         if self._writer is None:  # the frame size is known now
             self._writer = imageio_ffmpeg.write_frames(
@@ -264,6 +322,70 @@ class Video(LoopFunctions):
         self._writer.send(frame)
         self.frame_times_s.append(world.time_s)
         self._next_s = len(self.frame_times_s) * self.frame_interval_s
+
+    def _annotate(self, draw: ImageDraw.ImageDraw, world, poses: np.ndarray) -> None:
+        """Links, vertex and robot names, scale bar, legend and title over a frame."""
+        to_pixels = self.camera.to_pixels
+        links = list(self.links()) if self.links is not None else []
+        for a, b in links:
+            draw.line([tuple(p) for p in to_pixels([a, b])], fill=LINK_RGB, width=2)
+        for name, (col, row) in zip(self.camera.labels,
+                                    to_pixels(list(self.camera.labels.values()))):
+            draw.text((col + 5, row - 14), name, fill=(90, 90, 90), font=self._small)
+        notes = list(self.notes()) if self.notes is not None else [""] * world.n
+        on_floor = np.flatnonzero(world.present)
+        for i, (col, row) in zip(on_floor, to_pixels(poses[on_floor, :2])):
+            draw.text((col + 9, row - 8), f"{robot_name(i)} {notes[i]}".strip(), fill="black",
+                      font=self._small, stroke_width=2, stroke_fill="white")
+        self._scale_bar(draw)
+        self._legend(draw, world, notes, bool(links))
+        text = f"{self.title}  t = {world.time_s:7.1f} s  ({self.speedup:g}x)".strip()
+        draw.rectangle((0, 0, draw.im.size[0], TITLE_PX), fill=(255, 255, 255))
+        draw.text((8, 4), text, fill=(0, 0, 0), font=self._font)
+
+    def _scale_bar(self, draw: ImageDraw.ImageDraw) -> None:
+        """A bar of round length on the floor below the framed area's lower left corner,
+        named below."""
+        x0, y0, x1, y1 = self.bounds_m
+        length = max([m for m in SCALE_BARS_M if m <= (x1 - x0) / 4.0] or SCALE_BARS_M[:1])
+        y = y0 - 0.6 * MARGIN * max(y1 - y0, 0.5)
+        (a, row_a), (b, row_b) = self.camera.to_pixels([(x0, y), (x0 + length, y)])
+        draw.line([(a, row_a), (b, row_b)], fill="black", width=3)
+        for col, row in ((a, row_a), (b, row_b)):
+            draw.line([(col, row - 5), (col, row + 5)], fill="black", width=2)
+        draw.text(((a + b) / 2.0, max(row_a, row_b) + 7), f"{length:g} m", fill="black",
+                  font=self._small, anchor="ma", stroke_width=2, stroke_fill="white")
+
+    def _legend(self, draw: ImageDraw.ImageDraw, world, notes: Sequence[str],
+                links: bool) -> None:
+        """Each robot's colour and name (and where it is when off the floor), then the
+        marks and the radio links, in a box at the top right."""
+        entries = []  # (swatch: "dot" or "line", RGB, text)
+        for i in range(min(world.n, LEGEND_ROBOTS)):
+            where = ("" if world.present[i] else
+                     " docked at base" if i in world.docked else " in depot")
+            entries.append(("dot", robot_color(i)[:3], f"{robot_name(i)} {notes[i]}".rstrip()
+                            + where))
+        if world.n > LEGEND_ROBOTS:
+            entries.append(("", None, f"... {robot_name(world.n - 1)}: {world.n} robots"))
+        if self.marks is not None:
+            entries.append(("dot", tuple(int(255 * c) for c in MARK_RGBA[:3]),
+                            self.marks_label))
+        if links:
+            entries.append(("line", LINK_RGB, "radio link"))
+        line_px = 16
+        width = 30 + max(self._small.getlength(text) for _, _, text in entries)
+        right, top = draw.im.size[0] - 6, TITLE_PX + 6
+        left = right - width
+        draw.rectangle((left, top, right, top + 6 + line_px * len(entries)), fill="white",
+                       outline=(120, 120, 120))
+        for k, (swatch, rgb, text) in enumerate(entries):
+            row = top + 4 + line_px * k + line_px / 2.0
+            if swatch == "dot":
+                draw.ellipse((left + 8, row - 5, left + 18, row + 5), fill=rgb)
+            elif swatch == "line":
+                draw.line((left + 5, row, left + 21, row), fill=rgb, width=2)
+            draw.text((left + 26, row), text, fill="black", font=self._small, anchor="lm")
 
     @property
     def frames(self) -> int:
