@@ -101,9 +101,9 @@ def _texts(rrd) -> dict[str, list[str]]:
 @pytest.mark.parametrize(
     "argv,message",
     [
-        (["--speed", "0"], "speed must be positive"),
+        (["--speed", "0"], "--speed must be a finite number > 0"),
         (["--speed", "0.5"], "exceeds the robot's top speed"),
-        (["--launch-order", "1,1"], "launch order must be a permutation"),
+        (["--launch-order", "1,1"], "--launch-order must name each of R1..R2 once"),
         (["--launch-order", "a,b"], "--launch-order takes robot numbers"),
         (["--world", "moon"], "unknown world"),
         (["--robots", "0"], "at least one robot"),
@@ -111,9 +111,10 @@ def _texts(rrd) -> dict[str, list[str]]:
         (["--fault", "robot:7@3"], "there are robots 1..2"),
         (["--fault", "beacon:v99@3"], "'v99' is not a vertex"),
         (["--fault", "radio-blackout@3-9"], "needs robots with radios"),
-        (["--stall-timeout", "0"], "stall timeout must be positive"),
-        (["--wheel-slip", "-0.1"], "wheel slip must be in [0, 1)"),
-        (["--line-noise", "-1"], "noise standard deviations must be >= 0"),
+        (["--stall-timeout", "0"], "--stall-timeout must be a finite number > 0"),
+        (["--wheel-slip", "-0.1"], "--wheel-slip must be a finite number >= 0"),
+        (["--wheel-slip", "1"], "wheel slip must be in [0, 1)"),
+        (["--line-noise", "-1"], "--line-noise must be a finite number >= 0"),
     ],
 )
 def test_cli_embodied_bad_input_is_one_line(capsys, argv, message):

@@ -132,6 +132,9 @@ STALL_MIN_S = 300.0
 STALL_EDGE_FACTOR = 10.0
 #: Wall seconds between status lines when progress goes to a log, not a terminal.
 STATUS_EVERY_S = 30.0
+#: Building the world is reported (with its wall time) when it takes longer than this
+#: (s); on a terminal a transient line shows while it is being built.
+BUILD_NOTE_S = 2.0
 
 
 @dataclass
@@ -281,9 +284,10 @@ class EmbodiedExploration(LoopFunctions):
             raise MjswarmError(f"speed {config.speed_m_s} m/s exceeds the robot's top speed "
                                f"{top:.2f} m/s")
         self.recorder = recorder
-        if progress:
-            print(f"explore: building {spec.name} with {k} robot(s) ...", file=sys.stderr,
-                  flush=True)
+        terminal = progress and sys.stderr.isatty()
+        if terminal:  # a transient line, cleared when the world is built
+            print(f"explore: building {spec.name} with {k} robot(s) ...", end="\r",
+                  file=sys.stderr, flush=True)
         built = time.perf_counter()
         xs = [x for x, _ in spec.vertices.values()]
         ys = [y for _, y in spec.vertices.values()]
@@ -367,8 +371,12 @@ class EmbodiedExploration(LoopFunctions):
         self._vertex_ids = list(spec.vertices)
         self._nearest_version = -1  # _nearest_vertex's cache
         self.loop = Loop(self.world, dict(enumerate(self.robots)), [self])
-        if progress:
-            print(f"explore: built in {time.perf_counter() - built:.1f} s", file=sys.stderr)
+        took = time.perf_counter() - built
+        if terminal:
+            print("\033[K", end="", file=sys.stderr, flush=True)
+        if progress and took > BUILD_NOTE_S:
+            print(f"explore: built {spec.name} with {k} robot(s) in {took:.1f} s",
+                  file=sys.stderr, flush=True)
 
     @property
     def active(self) -> list[bool]:
