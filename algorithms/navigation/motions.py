@@ -317,8 +317,14 @@ class Scan:
 
 
 def _same_spoke(swept_between: float) -> bool:
-    """Two crossings ``swept_between`` (rad, odometry) apart are one spoke seen twice.
+    """Two crossings ``swept_between`` (rad, odometry) apart are one spoke seen twice:
+    within half the 45 degree minimum between the edges at a vertex of a full turn.
 
-    Odometry errs by a few per cent per turn, far less than the 45 degrees between spokes.
+    Before its first calibration odometry over-reads a turn by the contact patch's
+    scrub (1-2 per cent) and by wheel slip (``|N(0, s)|`` per tick and wheel: 0.8 s on
+    average, 4 per cent at ``--wheel-slip 0.05``): 380 degrees were measured for one
+    turn in the dynamic tier at 0.05, beyond the 20 degrees this test allowed before
+    issue 27. Half of 45 degrees is the most it can allow: a spoke 45 degrees from the
+    first one is then still told apart while odometry errs by less than 6 per cent.
     """
-    return abs(swept_between - 2.0 * math.pi) < math.radians(20.0)
+    return abs(swept_between - 2.0 * math.pi) < math.radians(22.5)
