@@ -1,11 +1,23 @@
-"""Issue 13's robustness stress grid (mjswarm.experiments.stress): a fast representative of each
-failure class by default, the whole grid with ``-m slow``."""
+"""Issue 13's robustness stress grid and issue 27's noise grid (mjswarm.experiments.stress):
+a fast representative of each failure class and of each noise by default, the whole grids
+with ``-m slow``."""
 
 from __future__ import annotations
 
 import pytest
 
-from mjswarm.experiments.stress import StressRun, grid, passed, run_grid, table
+from mjswarm.experiments.stress import (
+    MAX_HEADING_ERROR_DEG,
+    NOISES,
+    Noise,
+    StressRun,
+    grid,
+    noise_grid,
+    noise_table,
+    passed,
+    run_grid,
+    table,
+)
 
 
 @pytest.mark.parametrize("run", [
@@ -61,3 +73,45 @@ def test_a_lone_robot_keeps_its_heading_over_384_legs():
     result = StressRun("lattice:12x12", 1, 0.2, None).run(max_sim_time_s=20000.0)
     assert passed(result) and result.total_traversals >= 300
     assert result.heading_error_deg < 5.0
+
+
+@pytest.mark.parametrize("run", [
+    # 0.5 mm of line noise: scans found phantom spokes (the dynamic tier's floor reads
+    # 0.46 mm below the calibration, 0.54 mm from the old fixed threshold)
+    StressRun("fan:3:45@17", 1, 0.2, 0, Noise(line_m=0.0005), "dynamic"),
+    StressRun("fig9", 2, 0.15, 0, Noise(ir_m=0.002), "kinematic"),
+    StressRun("fig9", 2, 0.15, 0, Noise(bearing_deg=2.0), "kinematic"),
+    # slip 0.05: the first scan over-read a turn to 380 degrees, beyond the 20 degrees
+    # that told the first spoke coming round
+    StressRun("fan:3:45@17", 1, 0.2, 0, Noise(wheel_slip=0.05), "dynamic"),
+    StressRun("fan:3:45@17", 1, 0.2, 1, NOISES[-1], "kinematic"),
+], ids=str)
+def test_noise_representatives(run):
+    result = run.run(max_sim_time_s=1200.0)
+    assert passed(result, MAX_HEADING_ERROR_DEG), (
+        result.ended_because, result.collisions, result.stopped_robots,
+        result.heading_error_deg)
+
+
+def test_noise_grid_covers_every_noise_alone_and_together_in_both_tiers():
+    runs = noise_grid(arenas=("fig9",), speeds=(0.1,), teams=(2,), seeds=(0,))
+    assert {(r.noise, r.physics) for r in runs} == {
+        (n, t) for n in NOISES for t in ("dynamic", "kinematic")}
+    together = NOISES[-1]
+    assert (together.line_m, together.ir_m, together.bearing_deg, together.wheel_slip) == (
+        0.0005, 0.002, 2.0, 0.05)
+
+
+def test_noise_table_counts_the_heading_criterion():
+    run = StressRun("issue13-fan", 1, 0.2, 0, Noise(ir_m=0.002), "kinematic")
+    rows = [(run, run.run(), 1.0)]
+    assert "| IR 2 mm | kinematic | 1 | 1 | 1 | 0 | 0 |" in noise_table(rows)
+
+
+@pytest.mark.slow
+def test_the_whole_noise_grid_passes():
+    rows = run_grid(noise_grid(), workers=2)
+    failures = [(r, res.ended_because, res.collisions, res.stopped_robots,
+                 res.heading_error_deg)
+                for r, res, _ in rows if not passed(res, MAX_HEADING_ERROR_DEG)]
+    assert failures == []

@@ -268,7 +268,7 @@ class Explorer(Controller):
         """Navigator, vertex calls, the speed rule and vertex entry: this tick's command."""
         nav, sense = self.nav, self._sense(out)
         v, w = nav.update(percept(observation.line_m, observation.ir_m,
-                                  observation.encoder_rad, self.calibration.line_floor_m))
+                                  observation.encoder_rad, nav.line_filter))
         self._on_events(observation, out)
         if self.halted is not None or self.declared:
             return Command(messages=tuple(out))

@@ -17,5 +17,5 @@ class Navigating(Controller):
     def step(self, observation: Observation) -> Command:
         nav = self.navigator
         v, w = nav.update(percept(observation.line_m, observation.ir_m,
-                                  observation.encoder_rad, nav.cal.line_floor_m))
+                                  observation.encoder_rad, nav.line_filter))
         return Command(v, w)

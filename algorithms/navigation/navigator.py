@@ -58,7 +58,7 @@ from algorithms.navigation.motions import (
     wrap,
 )
 from algorithms.navigation.odometry import Odometry, RobotCalibration
-from algorithms.navigation.percept import Percept
+from algorithms.navigation.percept import LineFilter, Percept
 
 SHIFT_ANGLE = math.radians(60.0)
 #: Top speed (m/s) of the approach to a vertex centre (finding and following the spoke,
@@ -76,6 +76,7 @@ class ArenaConventions:
     spoke_inner_radius_m: float
     spoke_radius_m: float
     wall_distance_m: float  # left IR reading of the corridor wall from the lane
+    strip_width_m: float  # width of every floor strip, lanes and spokes
     wall_tolerance_m: float = 0.012
     min_wall_run_m: float = 0.05
     max_seek_m: float = 0.40
@@ -127,6 +128,8 @@ class Navigator:
                  turn_rate_rad_s: float = 1.0) -> None:
         self.cal, self.conv = calibration, conventions
         self.odometry = Odometry(calibration, theta=heading)
+        #: its line detection (:func:`~.percept.percept` reads through it)
+        self.line_filter = LineFilter(calibration.line_floor_m)
         self.speed = speed_m_s
         self._approach_speed = min(speed_m_s, APPROACH_SPEED_M_S)
         self.turn_rate = turn_rate_rad_s
@@ -353,7 +356,16 @@ class Navigator:
         self.state = NavigatorState.SCANNING
         self._scans += 1
         direction = 1 if self._scans % 2 else -1  # alternate: see the module docstring
-        self._plan = deque([(Scan(self.turn_rate, direction), self._scanned)])
+        self._plan = deque([(Scan(self.turn_rate, direction, self._spoke_min_width),
+                             self._scanned)])
+
+    @property
+    def _spoke_min_width(self) -> float:
+        """The narrowest run of the scan's centre sensor on a strip that counts as a
+        spoke (rad): half the angle a ``strip_width_m`` strip spans at the sensor's
+        ``line_ahead_m`` (35 degrees for the 30 mm strips at 50 mm: runs are 35 degrees
+        noise-free, a noisy flicker is a tick's 1.2 degrees)."""
+        return math.asin(self.conv.strip_width_m / 2.0 / self.cal.line_ahead_m)
 
     def _scanned(self, scan: Scan) -> None:
         """Calibrate, then turn the scan's crossings into incidence angles."""

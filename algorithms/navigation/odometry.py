@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
+
+from algorithms.navigation.percept import LINE_WINDOW_MAX
 
 
 @dataclass(frozen=True)
@@ -42,11 +45,15 @@ class Odometry:
         self.x, self.y, self.theta = x, y, theta
         self.distance_m = 0.0  # total path length driven (forward counts positive)
         self._last: tuple[float, float] | None = None
+        #: distance_m after each of the last updates, newest last: what
+        #: :meth:`distance_back` answers for a filtered percept's lag
+        self._past: deque[float] = deque(maxlen=LINE_WINDOW_MAX)
 
     def update(self, encoders: tuple[float, float]) -> None:
         """Integrate the wheel motion since the previous call."""
         if self._last is None:
             self._last = encoders
+            self._past.append(self.distance_m)
             return
         dl = encoders[0] - self._last[0]
         dr = encoders[1] - self._last[1]
@@ -59,6 +66,14 @@ class Odometry:
         self.y += ds * math.sin(mid)
         self.theta += dtheta
         self.distance_m += ds
+        self._past.append(self.distance_m)
+
+    def distance_back(self, ticks: int) -> float:
+        """``distance_m`` as it was ``ticks`` updates ago (0: now; a filtered percept's
+        lag is at most ``(LINE_WINDOW_MAX - 1) / 2``), or the oldest kept."""
+        if not self._past:
+            return self.distance_m
+        return self._past[max(-len(self._past), -1 - ticks)]
 
     def correct_heading(self, delta_rad: float) -> None:
         """Rotate the heading estimate by ``delta_rad`` (a landmark-based correction)."""

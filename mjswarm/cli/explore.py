@@ -70,6 +70,7 @@ def run_embodied(args) -> dict:
         faults=[parse_fault(f) for f in args.fault or ()],
         line_noise_m=_or(args.line_noise, 0.0), ir_noise_m=_or(args.ir_noise, 0.0),
         wheel_slip=_or(args.wheel_slip, 0.0), physics=args.physics or defaults.physics,
+        bearing_noise_deg=_or(args.bearing_noise, defaults.bearing_noise_deg),
         connectivity=args.connectivity or "none")
     run = EmbodiedExploration(spec, make_minds(args.strategy, args.robots, args.seed), config,
                               args.seed, progress=True)
@@ -215,6 +216,9 @@ def register(subparsers) -> None:
     embodied.add_argument("--wheel-slip", type=float, default=None, metavar="S",
                           help="wheel slip: each tick each encoder over-reads its wheel's "
                                "turn by |N(0, S)| of it (default: 0)")
+    embodied.add_argument("--bearing-noise", type=float, default=None, metavar="DEG",
+                          help="standard deviation of the bearing sensor's noise, degrees "
+                               "(default: 0)")
     embodied.add_argument("--physics", choices=PHYSICS, default=None,
                           help="dynamic: MuJoCo's contact physics (default); kinematic: "
                                "robots move by their wheel kinematics and stop at contacts, "
@@ -234,6 +238,7 @@ EMBODIED_ONLY = {
     "launch_interval": "--launch-interval", "launch_order": "--launch-order",
     "stall_timeout": "--stall-timeout", "fault": "--fault",
     "line_noise": "--line-noise", "ir_noise": "--ir-noise", "wheel_slip": "--wheel-slip",
+    "bearing_noise": "--bearing-noise",
     "physics": "--physics",
     "record": "--record", "video": "--video", "video_speed": "--video-speed",
 }
@@ -261,7 +266,8 @@ def check_options(args) -> None:
                                args.stall_timeout, 0.0), ("--launch-interval",
                                args.launch_interval, None), ("--line-noise", args.line_noise,
                                None), ("--ir-noise", args.ir_noise, None),
-                               ("--wheel-slip", args.wheel_slip, None)):
+                               ("--wheel-slip", args.wheel_slip, None),
+                               ("--bearing-noise", args.bearing_noise, None)):
         _check_number(flag, value, least)
     if args.launch_order:
         launch_order(args.launch_order, args.robots)

@@ -7,11 +7,17 @@ m/s, several seeds. Every run must complete with the true map, no robot stopped 
 robot-robot contact. ``python -m mjswarm.experiments.stress`` runs the grid on a process pool and
 prints its table (the one in README); ``tests/test_stress.py`` runs a fast
 representative of each failure class by default and the whole grid with ``-m slow``.
+
+The noise grid (issue 27, ``--noise``): one arena of each class at every speed, under
+line noise 0.5 mm, IR noise 2 mm, bearing noise 2 degrees and wheel slip 0.05, each alone
+and all together, in both physics tiers, two seeds; it adds the criterion that the
+robots' odometry heading stays within ``MAX_HEADING_ERROR_DEG`` of the truth.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 import time
@@ -39,6 +45,39 @@ ARENAS = (
 )
 SPEEDS_M_S = (0.05, 0.1, 0.15, 0.2)
 TEAMS = (1, 4, 10)
+PHYSICS = ("dynamic", "kinematic")
+
+
+@dataclass(frozen=True)
+class Noise:
+    """Sensor noise and wheel slip of a run (:class:`EmbodiedConfig`'s fields; SI units,
+    bearings in degrees)."""
+
+    line_m: float = 0.0
+    ir_m: float = 0.0
+    bearing_deg: float = 0.0
+    wheel_slip: float = 0.0
+
+    def __str__(self) -> str:
+        parts = [f"line {self.line_m * 1e3:g} mm" if self.line_m else "",
+                 f"IR {self.ir_m * 1e3:g} mm" if self.ir_m else "",
+                 f"bearing {self.bearing_deg:g} deg" if self.bearing_deg else "",
+                 f"slip {self.wheel_slip:g}" if self.wheel_slip else ""]
+        return ", ".join(p for p in parts if p) or "none"
+
+
+#: Issue 27's noise levels: each at its largest alone, then all together.
+NOISES = (
+    Noise(line_m=0.0005), Noise(ir_m=0.002), Noise(bearing_deg=2.0), Noise(wheel_slip=0.05),
+    Noise(line_m=0.0005, ir_m=0.002, bearing_deg=2.0, wheel_slip=0.05),
+)
+#: The noise grid's arena classes: one of each kind of the grid above (fan, wheel, hex,
+#: triangular, rotated lattice, paper arena, random planar), teams of 1 and 4.
+NOISE_ARENAS = ("fan:3:45@17", "wheel:4@8", "hex:2x2@30", "tri:2x3@7", "lattice:4x4@33",
+                "arena2", "random-planar:8:1")
+NOISE_TEAMS = (1, 4)
+#: The noise grid's heading criterion (deg): issue 27's "heading error within 5 degrees".
+MAX_HEADING_ERROR_DEG = 5.0
 
 
 @dataclass(frozen=True)
@@ -49,6 +88,8 @@ class StressRun:
     robots: int
     speed_m_s: float
     seed: int | None
+    noise: Noise = Noise()
+    physics: str = "dynamic"
 
     def spec(self) -> ArenaSpec:
         if self.arena == ISSUE_13_FAN["name"]:
@@ -56,7 +97,11 @@ class StressRun:
         return load_arena(self.arena)
 
     def run(self, max_sim_time_s: float = 3600.0) -> EmbodiedResult:
-        config = EmbodiedConfig(speed_m_s=self.speed_m_s, max_sim_time_s=max_sim_time_s)
+        n = self.noise
+        config = EmbodiedConfig(speed_m_s=self.speed_m_s, max_sim_time_s=max_sim_time_s,
+                                line_noise_m=n.line_m, ir_noise_m=n.ir_m,
+                                bearing_noise_deg=n.bearing_deg, wheel_slip=n.wheel_slip,
+                                physics=self.physics)
         return explore_embodied(self.spec(), self.robots, config=config, seed=self.seed)
 
 
@@ -70,10 +115,18 @@ def grid(arenas=ARENAS, speeds=SPEEDS_M_S, teams=TEAMS, seeds=(0,)) -> list[Stre
     return runs
 
 
-def passed(result: EmbodiedResult) -> bool:
-    """The grid's criterion: complete, true map, nobody stopped, no contact."""
+def noise_grid(arenas=NOISE_ARENAS, speeds=SPEEDS_M_S, teams=NOISE_TEAMS, noises=NOISES,
+               physics=PHYSICS, seeds=(0, 1)) -> list[StressRun]:
+    """Issue 27's grid: every arena class at every speed under every noise, both tiers."""
+    return [StressRun(arena, k, v, s, noise, tier) for arena in arenas for k in teams
+            for v in speeds for noise in noises for tier in physics for s in seeds]
+
+
+def passed(result: EmbodiedResult, max_heading_error_deg: float = math.inf) -> bool:
+    """The grid's criterion: complete, true map, nobody stopped, no contact (and, for
+    the noise grid, ``MAX_HEADING_ERROR_DEG``)."""
     return (result.completed and result.map_correct and not result.stopped_robots
-            and result.collisions == 0)
+            and result.collisions == 0 and result.heading_error_deg <= max_heading_error_deg)
 
 
 def _timed(run: StressRun) -> tuple[StressRun, EmbodiedResult, float]:
@@ -108,6 +161,24 @@ def table(rows: list[tuple[StressRun, EmbodiedResult, float]]) -> str:
     return "\n".join(lines)
 
 
+def noise_table(rows: list[tuple[StressRun, EmbodiedResult, float]]) -> str:
+    """Markdown table of the noise grid, one line per noise and physics tier."""
+    lines = ["| noise | physics | runs | passed | completed with the true map | "
+             "contact events | stopped robots | worst heading error (deg) | wall time (s) |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for noise, tier in dict.fromkeys((r.noise, r.physics) for r, _, _ in rows):
+        mine = [(res, t) for r, res, t in rows if (r.noise, r.physics) == (noise, tier)]
+        lines.append(
+            f"| {noise} | {tier} | {len(mine)} | "
+            f"{sum(passed(res, MAX_HEADING_ERROR_DEG) for res, _ in mine)} | "
+            f"{sum(res.completed and res.map_correct for res, _ in mine)} | "
+            f"{sum(res.collisions for res, _ in mine)} | "
+            f"{sum(len(res.stopped_robots) for res, _ in mine)} | "
+            f"{max(res.heading_error_deg for res, _ in mine):.1f} | "
+            f"{sum(t for _, t in mine):.0f} |")
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m mjswarm.experiments.stress",
@@ -115,17 +186,28 @@ def main(argv: list[str] | None = None) -> int:
                     "exit status 1 if any run failed (the failures are listed).")
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                         help="processes (default: all cores)")
-    parser.add_argument("--arenas", default=",".join(ARENAS),
+    parser.add_argument("--arenas", default=None,
                         help="comma-separated arenas (default: the whole grid)")
-    parser.add_argument("--seeds", type=int, default=1, help="seeds 0..N-1 (default: 1)")
+    parser.add_argument("--seeds", type=int, default=None,
+                        help="seeds 0..N-1 (default: 1; the noise grid: 2)")
+    parser.add_argument("--noise", action="store_true",
+                        help="run issue 27's noise grid instead (--arenas defaults to its "
+                             "classes; every speed, noise level and physics tier)")
     args = parser.parse_args(argv)
-    runs = grid(arenas=args.arenas.split(","), seeds=range(args.seeds))
+    if args.noise:
+        arenas = NOISE_ARENAS if args.arenas is None else args.arenas.split(",")
+        runs = noise_grid(arenas=arenas, seeds=range(args.seeds or 2))
+        heading = MAX_HEADING_ERROR_DEG
+    else:
+        arenas = ARENAS if args.arenas is None else args.arenas.split(",")
+        runs, heading = grid(arenas=arenas, seeds=range(args.seeds or 1)), math.inf
     rows = run_grid(runs, args.workers)
-    print(table(rows))
-    failures = [(r, res) for r, res, _ in rows if not passed(res)]
+    print(noise_table(rows) if args.noise else table(rows))
+    failures = [(r, res) for r, res, _ in rows if not passed(res, heading)]
     for r, res in failures:
         print(f"FAILED {r}: {res.ended_because}, contacts {res.collisions}, "
-              f"stopped {res.stopped_robots}", file=sys.stderr)
+              f"stopped {res.stopped_robots}, heading error {res.heading_error_deg:.1f} deg",
+              file=sys.stderr)
     return 1 if failures else 0
 
 

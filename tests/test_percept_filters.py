@@ -1,0 +1,115 @@
+"""Issue 27: the line filter and the scan hold under sensor noise (pure, no physics)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from algorithms.collision import CollisionRule
+from algorithms.navigation.motions import Scan
+from algorithms.navigation.odometry import Odometry, RobotCalibration
+from algorithms.navigation.percept import LINE_THRESHOLD_M, LineFilter, percept
+
+FLOOR_M = 0.020  # the calibration's bare-floor reading
+SUNK_M = 0.0195  # what the dynamic tier reads over the floor: the body sinks 0.46 mm
+STRIP_M = 0.002  # strip height
+
+
+def single_threshold(d: float) -> bool:
+    """The detection before issue 27: one reading against one threshold."""
+    return FLOOR_M - d > LINE_THRESHOLD_M
+
+
+@pytest.mark.parametrize("sigma", [0.00025, 0.0005])
+def test_bare_floor_never_reads_as_a_strip(sigma):
+    """The dynamic tier's floor under noise: the single threshold sees strips several
+    times a second (0.25 mm leaves it 2 sigma), the filter none after its warm-up."""
+    rng = np.random.default_rng(1)
+    readings = SUNK_M + rng.normal(0.0, sigma, (3000, 3))
+    flt = LineFilter(FLOOR_M)
+    filtered = [flt(r)[0] for r in readings]
+    assert sum(any(single_threshold(d) for d in r) for r in readings) > 100  # teeth
+    assert not any(any(on) for on in filtered[50:])
+
+
+def test_a_strip_is_seen_as_one_run_with_its_lag():
+    """Floor, 30 ticks of strip, floor, at 0.5 mm: one run, of the strip's length,
+    reported ``lag`` ticks late."""
+    rng = np.random.default_rng(2)
+    truth = [False] * 200 + [True] * 30 + [False] * 100
+    flt = LineFilter(FLOOR_M)
+    out = []
+    for on in truth:
+        d = SUNK_M - (STRIP_M if on else 0.0)
+        (left, centre, right), lag = flt([d + rng.normal(0, 0.0005) for _ in range(3)])
+        out.append((centre, lag))
+    centre = [c for c, _ in out]
+    rises = [i for i in range(1, len(centre)) if centre[i] and not centre[i - 1]]
+    falls = [i for i in range(1, len(centre)) if centre[i - 1] and not centre[i]]
+    assert len(rises) == len(falls) == 1
+    lag = out[rises[0]][1]
+    assert lag == 3  # window 7 at 0.5 mm (5 sigmas: 6.25 readings)
+    assert abs(rises[0] - lag - 200) <= 2 and abs(falls[0] - lag - 230) <= 2
+
+
+def test_noise_free_readings_pass_unfiltered():
+    """Exact sensors: window 1 and no lag once the noise is known (results unchanged)."""
+    flt = LineFilter(FLOOR_M)
+    for _ in range(20):
+        flt([FLOOR_M, FLOOR_M - STRIP_M, FLOOR_M])
+    assert flt.window == 1
+    assert flt([FLOOR_M - STRIP_M, FLOOR_M, FLOOR_M]) == ((True, False, False), 0)
+
+
+def scan_spokes(spokes_deg, sigma, seed, min_width):
+    """A robot scanning in place at 1 rad/s, 50 Hz, over spokes 35 degrees wide (a 30 mm
+    strip at the sensor's 50 mm); returns the Scan when done."""
+    rng = np.random.default_rng(seed)
+    odo = Odometry(RobotCalibration(0.025, 0.12, 0.05, 0.2))
+    flt = LineFilter(FLOOR_M)
+    scan = Scan(1.0, 1, min_width)
+    half = math.degrees(math.asin(0.3))
+    theta = 0.0
+    for _ in range(2000):
+        on = any(abs(math.remainder(math.degrees(theta) - s, 360.0)) < half for s in spokes_deg)
+        d = SUNK_M - (STRIP_M if on else 0.0)
+        odo.theta = theta
+        odo.update((0.0, 0.0))
+        p = percept([d + rng.normal(0, sigma) for _ in range(3)], [math.nan] * 3, (0.0, 0.0),
+                    flt)
+        if scan.step(odo, p) is None:
+            return scan
+        theta += 0.02
+    return scan
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_scan_finds_each_spoke_once_at_its_centre_under_noise(seed):
+    spokes = [100.0, 145.0, 260.0]
+    scan = scan_spokes(spokes, 0.0005, seed, math.asin(0.3))
+    assert scan.full_turn == pytest.approx(2 * math.pi, abs=math.radians(2))
+    found = sorted(math.degrees(m) % 360 for m in scan.mids)
+    assert found == pytest.approx(spokes, abs=2.0)
+
+
+def test_bearing_noise_neither_triggers_nor_suppresses_the_rule():
+    """2 degrees of bearing noise: a robot whose bearing turns at 0.1 rad/s (passing) is
+    never taken for a collision course; one at a constant bearing (a collision course)
+    is, within the longest window. The 10-sample window alone (the rule before issue
+    27) triggers on the passing robot."""
+    rng = np.random.default_rng(3)
+    noise = math.radians(2.0)
+    passing = [{1: 0.4 + 0.1 * 0.02 * i + rng.normal(0, noise)} for i in range(300)]
+    rule = CollisionRule(0.1, 0.2)
+    assert [rule.update(b) for b in passing] == [0.1] * 300
+    betas = [b[1] for b in passing]
+    slopes = [np.polyfit(np.arange(10) * 0.02, betas[i:i + 10], 1)[0] for i in range(290)]
+    assert sum(abs(r) < rule.zero_rate for r in slopes) > 5  # teeth: a fixed 10 triggers
+    course = [{1: 0.4 + rng.normal(0, noise)} for _ in range(120)]
+    rule = CollisionRule(0.1, 0.2)
+    speeds = [rule.update(b) for b in course]
+    assert speeds[-1] == pytest.approx(0.08) and rule.activations == 1
+    short = CollisionRule(0.1, 0.2, max_window=20)  # too short to tell: suppressed
+    assert [short.update(b) for b in course] == [0.1] * 120
