@@ -83,3 +83,44 @@ def test_spread_and_bad_parameters():
         spread(200, 0.3, seed=1)
     with pytest.raises(MjswarmError, match="at least one robot"):
         PointWorld([])
+
+
+class _Drive(Controller):
+    """Drives straight ahead at 0.1 m/s, or at a planar velocity along +x."""
+
+    def __init__(self, planar: bool = False) -> None:
+        self.planar = planar
+
+    def step(self, observation: Observation) -> Command:
+        return Command(velocity_m_s=(0.1, 0.0)) if self.planar else Command(0.1, 0.0)
+
+
+@pytest.mark.parametrize("world", [PointWorld, EmbodiedFloor])
+def test_a_control_period_is_integrated_exactly(world):
+    """Issue 28: with patrol's 0.15 s tick both worlds drove 0.16 s per tick (ten ticks at
+    0.1 m/s ended at x = 0.160 m)."""
+    w = world([(0.0, 0.0)], control_dt_s=0.15)
+    Loop(w, {0: _Drive()}).run(max_ticks=10)
+    assert w.time_s == pytest.approx(1.5)
+    expected = 0.150 if world is PointWorld else 0.1439  # the motors' 0.05 s speed ramp
+    assert w.true_poses()[0, 0] == pytest.approx(expected, abs=5e-4)
+
+
+@pytest.mark.parametrize("make, words", [
+    (lambda: PointWorld([(0.0, 0.0)], dt_s=0.02, control_dt_s=0.15), "integration step"),
+    (lambda: EmbodiedFloor([(0.0, 0.0)], control_dt_s=0.015), "physics step 0.002"),
+])
+def test_a_period_that_is_no_whole_number_of_steps_is_refused(make, words):
+    with pytest.raises(MjswarmError, match=words):
+        make()
+
+
+def test_the_tracker_steers_by_the_one_reading_the_robot_observed():
+    """One positioning reading per tick (it was drawn twice: the tracker used another
+    noisy reading than the controller saw)."""
+    w = PointWorld([(0.0, 0.0)], position_noise_m=0.01, heading_noise_rad=0.05)
+    readings = []
+    sense = w.sense
+    w.sense = lambda: readings.append(1) or sense()
+    Loop(w, {0: _Drive(planar=True)}).run(max_ticks=20)
+    assert len(readings) == 20

@@ -103,11 +103,8 @@ def test_hooks_run_in_order_and_stop_the_loop():
         def before_step(self, loop):
             calls.append("before")
 
-        def after_act(self, loop, robot):
-            calls.append(f"act {robot}")
-
         def after_step(self, loop):
-            calls.append("after")
+            calls.append(f"after {loop.stepped}")
 
         def should_stop(self, loop):
             return loop.ticks == 2
@@ -117,8 +114,62 @@ def test_hooks_run_in_order_and_stop_the_loop():
 
     world = PointWorld([(0.0, 0.0), (1.0, 0.0)])
     assert Loop(world, {0: Recorder(), 1: Recorder()}, [Trace()]).run() == [2]
-    assert calls == ["initialize"] + ["before", "act 0", "act 1", "after"] * 2
+    assert calls == ["initialize"] + ["before", "after [0, 1]"] * 2
     assert world.time_s == pytest.approx(0.2)
+
+
+class Logged(PointWorld):
+    """A point world that logs the loop's calls."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self.log: list[str] = []
+
+    def observe(self, i):
+        self.log.append(f"observe {i}")
+        return super().observe(i)
+
+    def act(self, i, command):
+        self.log.append(f"act {i}")
+        super().act(i, command)
+
+    def step(self):
+        self.log.append("step")
+        super().step()
+
+
+class Counting(Recorder):
+    def __init__(self) -> None:
+        super().__init__()
+        self.resets = 0
+
+    def reset(self) -> None:
+        self.resets += 1
+        self.seen.clear()
+
+
+def test_the_loop_senses_all_then_controls_all_then_acts_all_then_steps():
+    """ARGoS's phases (issue 28): no robot acts before every robot has sensed."""
+    world = Logged([(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)])
+    Loop(world, {i: Recorder() for i in range(3)}).run(max_ticks=2)
+    tick = ["observe 0", "observe 1", "observe 2", "act 0", "act 1", "act 2", "step"]
+    assert world.log == tick * 2
+
+
+def test_the_loop_resets_a_controller_when_its_robot_enters_the_floor():
+    world = PointWorld([(0.0, 0.0), (1.0, 0.0)], present=[True, False])
+    robots = {0: Counting(), 1: Counting()}
+    loop = Loop(world, robots)
+    loop.run(max_ticks=2)
+    assert (robots[0].resets, robots[1].resets) == (1, 0)  # before its first step only
+    world.place(1, (1.0, 0.0))
+    loop.run(max_ticks=3)
+    assert (robots[0].resets, robots[1].resets) == (1, 1) and len(robots[1].seen) == 1
+    world.place(1, None)  # taken off the floor, then put back: a new episode
+    loop.run(max_ticks=4)
+    world.place(1, (1.0, 0.0))
+    loop.run(max_ticks=5)
+    assert robots[1].resets == 2 and len(robots[1].seen) == 1
 
 
 def test_a_message_without_a_radio_is_an_error():

@@ -370,6 +370,10 @@ class EmbodiedExploration(LoopFunctions):
         self._vertices = np.array(list(spec.vertices.values()))
         self._vertex_ids = list(spec.vertices)
         self._nearest_version = -1  # _nearest_vertex's cache
+        #: (step count, time s, true poses) of the state the robots observed this tick,
+        #: and the clock the accounting reads (:meth:`_now`)
+        self._observed: tuple[int, float, np.ndarray] | None = None
+        self._clock: tuple[int, float, np.ndarray] | None = None
         self.loop = Loop(self.world, dict(enumerate(self.robots)), [self])
         took = time.perf_counter() - built
         if terminal:
@@ -490,8 +494,9 @@ class EmbodiedExploration(LoopFunctions):
                     self.awaiting_clear.add(i)
                 self.uplink.reply(i, EntryGranted(clear, self.asked[i]))
                 self._event(i, f"R{i + 1} granted {vertex}")
+        self._observed = (self.sim.step_count, self.sim.time_s, self.sim.poses().copy())
 
-    def after_act(self, loop: Loop, i: int) -> None:
+    def _robot_ticked(self, i: int) -> None:
         """What robot ``i`` did this tick, for the metrics and the recording."""
         robot = self.robots[i]
         if self._truth is not None and i in self._truth:
@@ -510,7 +515,13 @@ class EmbodiedExploration(LoopFunctions):
         self._last_speed[i] = robot.speed_m_s
 
     def after_step(self, loop: Loop) -> None:
+        """The tick's robots (accounted at the state they observed, as when they
+        decided), then the radio's truth and the recording of the new state."""
         sim = self.sim
+        self._clock = self._observed
+        for i in loop.stepped:
+            self._robot_ticked(i)
+        self._clock = None
         if self._truth is not None:
             self._sample_beliefs()
         if self.base is not None and any(self.world.present):
@@ -633,10 +644,10 @@ class EmbodiedExploration(LoopFunctions):
         if self.sim.time_s - self.last_launch < self.config.launch_interval_s:
             return
         root = np.array(self.spec.vertices[self.spec.root])
-        poses = self.sim.poses()
-        for j, on in enumerate(self.active):
-            if on and not self.done[j] and np.hypot(*(poses[j, :2] - root)) < ROOT_CLEAR_M:
-                return
+        near = np.hypot(*(self.sim.poses()[:, :2] - root).T) < ROOT_CLEAR_M
+        active, done = self.active, self.done  # each a pass over the team: once
+        if any(active[j] and not done[j] for j in np.flatnonzero(near)):
+            return
         if self.config.collision_avoidance and self.spec.root in self.stations.holder:
             return
         i = self.launch_queue.pop(0)
@@ -645,7 +656,6 @@ class EmbodiedExploration(LoopFunctions):
         if self.config.collision_avoidance:
             self.stations.occupy(i, self.spec.root)
         self.target[i] = self.spec.root
-        self.robots[i].reset()
         self._event(i, f"R{i + 1} launched at {self.spec.root}")
 
     # ------------------------------------------------------------------ robots
@@ -653,7 +663,7 @@ class EmbodiedExploration(LoopFunctions):
         vertex = self._nearest_vertex(i)[0]  # where it stands (its beacon was served)
         if call.arrived:
             self.paths[i].append(vertex)
-            self.last_progress_s = self.sim.time_s
+            self.last_progress_s = self._now()[1]
             self._event(i, f"R{i + 1} at {vertex}")
         self._measure_heading(i)
         if call.beacon.id is not None:
@@ -661,7 +671,7 @@ class EmbodiedExploration(LoopFunctions):
         if self.recorder is not None:
             self._record_vertex_call(i, vertex, call.beacon)
         if call.decision.action == "done":
-            self.declared = (self.sim.time_s, i, vertex)
+            self.declared = (self._now()[1], i, vertex)
             self._event(i, f"R{i + 1} declares completion at {vertex}")
             self._event(None, f"R{i + 1} declared completion at {vertex}")
         elif call.decision.action == "go" and not self.config.collision_avoidance:
@@ -669,7 +679,7 @@ class EmbodiedExploration(LoopFunctions):
 
     def _stopped(self, i: int, reason: str) -> None:
         self._reported.add(i)
-        self.stopped.append({"robot": i + 1, "reason": reason, "at_s": round(self.sim.time_s, 2)})
+        self.stopped.append({"robot": i + 1, "reason": reason, "at_s": round(self._now()[1], 2)})
         self._event(i, f"R{i + 1} stopped: {reason}")
 
     def fail(self, i: int, reason: str) -> None:
@@ -691,7 +701,7 @@ class EmbodiedExploration(LoopFunctions):
         """Track ``heading_error_deg``: sampled where the heading is in use, on a lane and
         at vertex calls (mid-scan the odometry over-reads rotation until the scan's own
         calibration corrects it)."""
-        true_yaw = self.sim.poses()[i, 2]
+        true_yaw = self._now()[2][i, 2]
         error = abs(math.remainder(self.robots[i].nav.odometry.theta - true_yaw, 2 * math.pi))
         self.heading_error_rad = max(self.heading_error_rad, error)
 
@@ -724,7 +734,7 @@ class EmbodiedExploration(LoopFunctions):
 
     def _record_vertex_call(self, i: int, vertex: str, beacon: Beacon) -> None:
         """Beacon contents and the robot's map (beacon ids shown as arena vertices)."""
-        step, now = self.sim.step_count, self.sim.time_s
+        step, now, _ = self._now()
         self.recorder.log_beacon(step, now, vertex, f"beacon {beacon.id}\n{beacon.data!r}")
         edges = [(self.beacon_vertex[a], self.beacon_vertex[b])
                  for a, b in self.minds[i].map_edges()
@@ -765,9 +775,18 @@ class EmbodiedExploration(LoopFunctions):
         return infeasible_reason(len(self.robots), self.config.radio_range_m, self.paths,
                                  len(self.spec.edges))
 
+    def _now(self) -> tuple[int, float, np.ndarray]:
+        """The step count, simulated time (s) and true poses the accounting refers to:
+        while the tick's robots are accounted (:meth:`after_step`), the state they
+        observed; else the world's present state."""
+        if self._clock is not None:
+            return self._clock
+        return self.sim.step_count, self.sim.time_s, self.sim.poses()
+
     def _event(self, i: int | None, text: str) -> None:
         if self.recorder is not None:
-            self.recorder.log_event(self.sim.step_count, self.sim.time_s, text, i)
+            step, now, _ = self._now()
+            self.recorder.log_event(step, now, text, i)
 
     # ------------------------------------------------------------------ metrics
     def result(self, loop: Loop | None = None, wall: float = 0.0) -> EmbodiedResult:

@@ -9,16 +9,24 @@ each robot's :class:`~algorithms.robot.Observation`, applies each
 keeps the vertex stations, injects faults, measures and records. Only loop functions see
 ground truth (:meth:`World.true_poses`, contacts); controllers see observations.
 
-One control tick (:meth:`Loop.step`)::
+One control tick (:meth:`Loop.step`) runs in phases, as ARGoS's space does (sense and
+control every robot, then act for all, then the physics), and loop functions hook in
+between phases, never between two robots::
 
     for f in functions: f.before_step(loop)
-    for i in world.active():                   # robots on the floor, in id order
-        command = controllers[i].step(world.observe(i))
-        world.act(i, command)                  # motion set-point, messages, signal
-        for f in functions: f.after_act(loop, i)
+    robots = world.active()                      # robots on the floor, in id order
+    for i in robots entering the floor: controllers[i].reset()
+    observations = [world.observe(i) for i in robots]              # sense all
+    commands = [controllers[i].step(o) for i, o in ...]            # control all
+    for i, c in zip(robots, commands): world.act(i, c)             # act all
     world.step()                               # physics, then the radio delivers
-    for f in functions: f.after_step(loop)
+    for f in functions: f.after_step(loop)     # loop.stepped: the robots of this tick
     stop = any(f.should_stop(loop) for f in functions)
+
+Every observation of a tick is of one world state: acting changes nothing a later robot
+of the same tick observes (motion and messages take effect in ``world.step()``). A
+beacon is the exception by design: it is the vertex's store, and robots that stand on
+one vertex in one tick read and write it one after another, in the order they step.
 
 Messages sent in a tick are delivered at the end of that tick's ``world.step()`` and read
 in the next tick's observations: the radio's one tick of latency (seed 002 Assumption 4).
@@ -175,9 +183,6 @@ class LoopFunctions:
     def before_step(self, loop: Loop) -> None:
         """Start of a tick, before any robot acts (launches, faults, station grants)."""
 
-    def after_act(self, loop: Loop, robot: int) -> None:
-        """After one robot's command was applied (e.g. a message cap)."""
-
     def after_step(self, loop: Loop) -> None:
         """After the world stepped (measurements, recording)."""
 
@@ -194,7 +199,10 @@ class Loop:
     """Runs ``controllers`` (by robot id) in ``world`` with ``functions``' hooks.
 
     ``halted`` holds the robots the loop no longer steps (a robot that failed); loop
-    functions add to it with :meth:`halt`.
+    functions add to it with :meth:`halt`. ``stepped`` lists the robots stepped in the
+    last tick, in order. A robot's controller is reset (:meth:`Controller.reset`) when the
+    robot enters the floor: before its first step, and again after each time it was
+    off the floor.
     """
 
     def __init__(self, world: World, controllers: Mapping[int, Controller],
@@ -202,9 +210,10 @@ class Loop:
         self.world = world
         self.controllers: dict[int, Controller] = dict(controllers)
         self.functions: list[LoopFunctions] = []
-        self._after_act: list[LoopFunctions] = []
         self.ticks = 0
         self.halted: set[int] = set()
+        self.stepped: list = []
+        self._on_floor: set = set()  # robots stepped in the last tick: no reset now
         self._stop = False
         for f in functions:
             self.add(f)
@@ -212,8 +221,6 @@ class Loop:
     def add(self, function: LoopFunctions) -> None:
         """Hook in one more loop function (a recording, a video); it is initialized now."""
         self.functions.append(function)
-        if type(function).after_act is not LoopFunctions.after_act:
-            self._after_act.append(function)
         function.initialize(self)
 
     def halt(self, robot: int) -> None:
@@ -231,17 +238,17 @@ class Loop:
         for f in self.functions:
             f.before_step(self)
         robots = [i for i in world.active() if i not in self.halted]
-        if self._after_act:
+        if len(self._on_floor) != len(robots) or not self._on_floor.issuperset(robots):
             for i in robots:
-                world.act(i, controllers[i].step(world.observe(i)))
-                for f in self._after_act:
-                    f.after_act(self, i)
-                if self._stop:
-                    break
-        else:  # the same without hooks, which many robots make worth a loop of its own
-            observe, act = world.observe, world.act
-            for i in robots:
-                act(i, controllers[i].step(observe(i)))
+                if i not in self._on_floor:
+                    controllers[i].reset()
+            self._on_floor = set(robots)
+        observe, act = world.observe, world.act
+        observations = [observe(i) for i in robots]
+        commands = [controllers[i].step(o) for i, o in zip(robots, observations)]
+        for i, command in zip(robots, commands):
+            act(i, command)
+        self.stepped = robots
         world.step()
         self.ticks += 1
         for f in self.functions:

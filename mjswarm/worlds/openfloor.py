@@ -37,6 +37,29 @@ from mjswarm.core.robot import spark_v_geometry
 
 #: The turn rate we allow the tracker (rad/s); the top speed is the robot model's.
 OMEGA_MAX_RAD_S = 2.0
+#: Longest integration step of the point world, and longest sensing period of the
+#: MuJoCo floor (s): the Spark V's 50 Hz control rate.
+MAX_SUBSTEP_S = 0.02
+
+
+def whole_steps(period_s: float, step_s: float, what: str) -> int:
+    """How many ``step_s`` make ``period_s``; :class:`MjswarmError` unless a whole number
+    (a world integrates exactly its control period, never a rounded one)."""
+    ratio = period_s / step_s
+    steps = round(ratio)
+    if steps < 1 or abs(ratio - steps) > 1e-6:
+        raise MjswarmError(f"control period {period_s:g} s is not a whole number of the "
+                           f"{what} step {step_s:g} s")
+    return steps
+
+
+def substeps(period_s: float, step_s: float, what: str) -> tuple[int, int]:
+    """``period_s`` as ``(ticks, steps)``: ``ticks`` sub-periods of ``steps`` steps of
+    ``step_s`` each, the sub-period the longest not over :data:`MAX_SUBSTEP_S`."""
+    n = whole_steps(period_s, step_s, what)
+    k = max(d for d in range(1, n + 1) if n % d == 0 and d * step_s <= MAX_SUBSTEP_S + 1e-12) \
+        if step_s <= MAX_SUBSTEP_S else n
+    return n // k, k
 
 
 class MotionWorld(World, ABC):
@@ -84,8 +107,8 @@ class MotionWorld(World, ABC):
         return self._time_s
 
     @abstractmethod
-    def _advance(self, v: np.ndarray, omega: np.ndarray, duration_s: float) -> None:
-        """Drive every present robot with ``(v, omega)`` for ``duration_s`` seconds."""
+    def _advance(self, v: np.ndarray, omega: np.ndarray) -> None:
+        """Drive every present robot with ``(v, omega)`` for one control period."""
 
     def place(self, i: int, xy: tuple[float, float] | None, yaw: float = 0.0) -> None:
         """Put robot ``i`` on the floor at ``xy`` (m) heading ``yaw`` (rad), or take it off
@@ -128,8 +151,12 @@ class MotionWorld(World, ABC):
         self._send(i, command.messages)
 
     def step(self) -> None:
-        """Follow every present robot's command for one control period, then the radio."""
-        sensed = self.sense()
+        """Follow every present robot's command for one control period, then the radio.
+        The velocity tracker (the robot's own motion control) steers by the positioning
+        reading the robot observed this tick: one reading per tick."""
+        if self._sensed is None:
+            self._sensed = self.sense()
+        sensed = self._sensed
         v_max = spark_v_geometry().max_speed_m_s
         v, omega = np.zeros(self.n), np.zeros(self.n)
         for i, c in enumerate(self._commands):
@@ -140,7 +167,7 @@ class MotionWorld(World, ABC):
                                                 v_max, self.omega_max_rad_s)
             else:
                 v[i], omega[i] = c.v_m_s, c.omega_rad_s
-        self._advance(v, omega, self.control_dt_s)
+        self._advance(v, omega)
         self._speeds = v
         self._time_s += self.control_dt_s
         self._sensed = self._detections = None
@@ -173,14 +200,22 @@ class MotionWorld(World, ABC):
 
 
 class PointWorld(MotionWorld):
-    """Kinematic unicycles: exact integration of ``(v, omega)``, no bodies, no contacts."""
+    """Kinematic unicycles: Euler integration of ``(v, omega)`` in steps of ``dt_s``
+    (default: the longest step up to :data:`MAX_SUBSTEP_S` that divides the control
+    period), no bodies, no contacts. A ``dt_s`` that does not divide the control period
+    is refused."""
 
     def __init__(self, positions, present=None, seed=0, position_noise_m=0.0,
-                 heading_noise_rad=0.0, dt_s: float = 0.02,
+                 heading_noise_rad=0.0, dt_s: float | None = None,
                  omega_max_rad_s: float = OMEGA_MAX_RAD_S, control_dt_s: float = 0.1,
                  detection_range_m: float | None = None) -> None:
         super().__init__(positions, present, seed, position_noise_m, heading_noise_rad,
                          omega_max_rad_s, control_dt_s, detection_range_m)
+        if dt_s is None:
+            dt_s = control_dt_s / math.ceil(control_dt_s / MAX_SUBSTEP_S - 1e-9)
+        elif not dt_s > 0:
+            raise MjswarmError(f"integration step must be positive, got {dt_s} s")
+        self._steps = whole_steps(control_dt_s, dt_s, "integration")
         self.dt_s = dt_s
         self._poses = np.zeros((self.n, 3))
         self._poses[:, :2] = np.asarray(positions, float)
@@ -192,8 +227,8 @@ class PointWorld(MotionWorld):
         if xy is not None:
             self._poses[i] = (xy[0], xy[1], yaw)
 
-    def _advance(self, v, omega, duration_s) -> None:
-        for _ in range(max(1, round(duration_s / self.dt_s))):
+    def _advance(self, v, omega) -> None:
+        for _ in range(self._steps):
             yaw = self._poses[:, 2]
             self._poses[:, 0] += v * np.cos(yaw) * self.dt_s
             self._poses[:, 1] += v * np.sin(yaw) * self.dt_s
@@ -204,7 +239,10 @@ class EmbodiedFloor(MotionWorld):
     """Spark V robots in MuJoCo on a bare floor; absent robots wait in a depot row.
 
     ``floor_half_size_m`` sizes the floor around the origin; the depot lies beyond it.
-    Robot-robot contacts are counted in ``self.sim.collisions``.
+    Robot-robot contacts are counted in ``self.sim.collisions``. The control period must
+    be a whole number of physics steps; the simulation senses (and counts contacts)
+    every sub-period of at most :data:`MAX_SUBSTEP_S` that divides it (0.1 s: five
+    0.02 s periods; 0.15 s: fifteen of 0.01 s).
     """
 
     def __init__(self, positions, present=None, seed=0, position_noise_m=0.0,
@@ -212,10 +250,11 @@ class EmbodiedFloor(MotionWorld):
                  omega_max_rad_s: float = OMEGA_MAX_RAD_S, control_dt_s: float = 0.1,
                  detection_range_m: float | None = None) -> None:
         from mjswarm.core.simulation import Simulation
-        from mjswarm.core.world import Pose2D, world_spec
+        from mjswarm.core.world import PHYSICS_TIMESTEP_S, Pose2D, world_spec
 
         super().__init__(positions, present, seed, position_noise_m, heading_noise_rad,
                          omega_max_rad_s, control_dt_s, detection_range_m)
+        self._ticks, steps = substeps(control_dt_s, PHYSICS_TIMESTEP_S, "physics")
         self._depot = [(-floor_half_size_m + 0.4 * i, -floor_half_size_m - 1.0)
                        for i in range(self.n)]
         poses = [Pose2D(*(positions[i] if self.present[i] else self._depot[i]), 0.0)
@@ -224,7 +263,7 @@ class EmbodiedFloor(MotionWorld):
                    (floor_half_size_m, floor_half_size_m)]
         spec = world_spec(poses, margin_m=1.5, floor_points=corners)
         self._pose_type = Pose2D
-        self.sim = Simulation(spec, seed=seed)
+        self.sim = Simulation(spec, seed=seed, control_hz=1.0 / (steps * PHYSICS_TIMESTEP_S))
 
     def true_poses(self) -> np.ndarray:
         return self.sim.poses()
@@ -236,9 +275,9 @@ class EmbodiedFloor(MotionWorld):
     def contact_events(self) -> list[tuple[float, int, int]]:
         return self.sim.collisions.events
 
-    def _advance(self, v, omega, duration_s) -> None:
+    def _advance(self, v, omega) -> None:
         self.sim.set_velocity(v, omega)
-        self.sim.step(max(1, round(duration_s / self.sim.control_dt_s)))
+        self.sim.step(self._ticks)
 
 
 def spread(n: int, radius_m: float, seed: int) -> list[tuple[float, float]]:

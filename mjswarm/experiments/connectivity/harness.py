@@ -101,17 +101,16 @@ class StaticWorld(World):
 
 class _Until(LoopFunctions):
     """Stops the harness when ``until()`` holds after a tick, or once more than ``cap``
-    messages were sent (checked after each robot's turn)."""
+    messages were sent (checked after each tick: a tick adds at most one round of
+    every robot's messages)."""
 
     def __init__(self, until: Callable[[], bool], cap: int | None) -> None:
         self.until, self.cap, self.capped = until, cap, False
 
-    def after_act(self, loop: Loop, robot: Hashable) -> None:
+    def should_stop(self, loop: Loop) -> bool:
         if self.cap is not None and loop.world.radio.total_sent > self.cap:
             self.capped = True
-            loop.stop()
-
-    def should_stop(self, loop: Loop) -> bool:
+            return True
         return self.until()
 
 
@@ -131,7 +130,7 @@ def drive(
     :class:`~mjswarm.worlds.loop.Loop` in a :class:`StaticWorld`. A tick's messages are
     delivered at its end (``radio.last_batch`` counts them). Returns ``(last tick,
     capped)``; capped means more than ``message_cap`` messages were sent (checked after
-    each robot's turn, so a dense flood cannot run away within a tick).
+    each tick).
     """
     stop = _Until(until, message_cap)
     loop = Loop(StaticWorld(radio, start), {r: Participant(m) for r, m in robots.items()},
