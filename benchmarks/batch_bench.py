@@ -30,7 +30,7 @@ Replicate r drives every robot forward at ``BENCH_SPEED_M_S * (1 - 0.01 r)`` (th
 is shared: every variant meets the same load, and its best run is its least disturbed);
 building ``MjData``/``Batch`` objects is not timed.
 
-Worlds: ``bench:N`` is :func:`mjswarm.outputs.bench.bench_world` with N robots; anything else is
+Worlds: ``bench:N`` is :func:`mjswarm.worlds.bench.bench_world` with N robots; anything else is
 an arena (:func:`mjswarm.arena.load_arena`) with ``arena_robots`` robots placed by
 :func:`vertex_poses`.
 
@@ -66,7 +66,8 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 from mjswarm.arena import ArenaSpec, load_arena
 from mjswarm.arena.builder import arena_world_spec
-from mjswarm.outputs.bench import BENCH_SPEED_M_S, bench_world
+from mjswarm.experiments.bench import BENCH_SPEED_M_S
+from mjswarm.worlds.bench import bench_world
 from mjswarm.errors import MjswarmError
 from mjswarm.core.robot import ACTUATORS, LINE_SENSORS
 from mjswarm.core.simulation import Simulation

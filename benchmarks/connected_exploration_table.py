@@ -21,7 +21,7 @@ from pathlib import Path
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from mjswarm.outputs.sweep import grid, run_cell  # noqa: E402
+from mjswarm.experiments.sweep import grid, run_cell  # noqa: E402
 
 ARENAS = "arena2,lattice:5x5,random-graph:12:16:3"
 ROBOTS = "4,8"

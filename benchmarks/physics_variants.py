@@ -30,7 +30,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from mjswarm.outputs.bench import BENCH_SPEED_M_S, bench_world
+from mjswarm.experiments.bench import BENCH_SPEED_M_S
+from mjswarm.worlds.bench import bench_world
 from mjswarm.core.robot import DEFAULT_ROBOT_XML
 
 CYLINDER_WHEEL = '<geom type="cylinder" size="0.025 0.006" mass="0.03"'

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from algorithms.robot import Command, Controller, Message, Observation
-from mjswarm.outputs.bench import bench_world
+from mjswarm.worlds.bench import bench_world
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.openfloor import PointWorld

@@ -10,7 +10,7 @@ from mjswarm.arena import load_arena
 from mjswarm.cli import main
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.graphworld import GraphWorld
-from mjswarm.outputs.sweep import CELL_KEYS, Cell, ResultsFile, grid, run_cell, sweep
+from mjswarm.experiments.sweep import CELL_KEYS, Cell, ResultsFile, grid, run_cell, sweep
 
 ARGS = ["sweep", "--arenas", "fig9,tree1", "--robots", "2-3", "--strategies",
         "incidence-dfs,mr-dfs", "--seeds", "0,1"]

@@ -52,7 +52,7 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
-    from mjswarm.outputs.bench import as_dict, run_bench
+    from mjswarm.experiments.bench import as_dict, run_bench
     from mjswarm.core.robot import DEFAULT_ROBOT_XML, load_robot_spec
 
     counts = _counts(args.robots)

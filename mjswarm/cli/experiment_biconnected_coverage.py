@@ -10,10 +10,10 @@ from contextlib import ExitStack
 from tqdm import tqdm
 
 from algorithms.maintenance.biconnected import PLACEMENTS
-from mjswarm.cli.output import atomic_output, check_writable, write_json
+from mjswarm.cli.output import check_outputs, check_writable, write_json
 from mjswarm.cli.video_options import add_video_options, check_video
-from mjswarm.experiments.coverage import WORLDS, area, run_coverage
-from mjswarm.outputs.video import Video
+from mjswarm.cli.watch import watchers
+from mjswarm.experiments.coverage import MAX_ROBOTS, WORLDS, area, run_coverage
 
 
 def register(subparsers) -> None:
@@ -55,19 +55,19 @@ def register(subparsers) -> None:
 def run(args: argparse.Namespace) -> int:
     check_writable(args.json, "JSON")  # before any work, not after it
     check_writable(args.record, "recording")
+    check_outputs({"--record": args.record, "--video": args.video, "--json": args.json},
+                  {"--record": ".rrd"})
     speedup = check_video(args)
     start = time.perf_counter()
     with ExitStack() as outputs:
-        record = outputs.enter_context(atomic_output(args.record, "recording")) \
-            if args.record else None
-        video = Video(outputs.enter_context(atomic_output(args.video, "video")),
-                      area(args.cr, args.region_diameter), speedup,
-                      title=f"coverage, cr {args.cr:g}") if args.video else None
+        functions = watchers(outputs, args, robots=MAX_ROBOTS,
+                             bounds_m=area(args.cr, args.region_diameter),
+                             name=f"biconnected coverage, cr {args.cr:g}, {args.world} world",
+                             title=f"coverage, cr {args.cr:g}", speedup=speedup)
         bar = outputs.enter_context(tqdm(total=args.episodes, desc="episodes", unit="ep",
                                          file=sys.stderr, disable=not sys.stderr.isatty()))
         result = run_coverage(args.cr, args.placement, args.episodes, args.seed, args.world,
-                              args.region_diameter, progress=bar.update, record=record,
-                              video=video)
+                              args.region_diameter, progress=bar.update, functions=functions)
     data = result.to_dict()
     data["wall_time_s"] = round(time.perf_counter() - start, 2)
     if write_json(data, args.json):

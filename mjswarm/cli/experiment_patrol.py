@@ -8,11 +8,11 @@ from contextlib import ExitStack
 
 from tqdm import tqdm
 
-from mjswarm.cli.output import atomic_output, check_writable, write_json
+from mjswarm.cli.output import check_outputs, check_writable, write_json
 from mjswarm.cli.video_options import add_video_options, check_video
+from mjswarm.cli.watch import watchers
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.patrol import STEP_S, WORLDS, area, run_patrol
-from mjswarm.outputs.video import Video
 
 
 def register(subparsers) -> None:
@@ -57,23 +57,23 @@ def register(subparsers) -> None:
 def run(args: argparse.Namespace) -> int:
     check_writable(args.json, "JSON")  # before any work, not after it
     check_writable(args.record, "recording")
+    check_outputs({"--record": args.record, "--video": args.video, "--json": args.json},
+                  {"--record": ".rrd"})
     speedup = check_video(args)
     if args.steps < 1:
         raise MjswarmError(f"need at least one step, got {args.steps}")
     if (args.record or args.video) and args.trials != 1:
         raise MjswarmError(f"--record and --video hold one mission; drop --trials {args.trials}")
     with ExitStack() as outputs:
-        record = outputs.enter_context(atomic_output(args.record, "recording")) \
-            if args.record else None
-        video = Video(outputs.enter_context(atomic_output(args.video, "video")),
-                      area(args.robots), speedup, title=f"patrol, N = {args.robots}") \
-            if args.video else None
+        functions = watchers(outputs, args, robots=args.robots, bounds_m=area(args.robots),
+                             name=f"patrol, N = {args.robots}, {args.world} world",
+                             title=f"patrol, N = {args.robots}", speedup=speedup)
         bar = outputs.enter_context(tqdm(total=args.trials * args.steps, desc="steps",
                                          unit="step", file=sys.stderr,
                                          disable=not sys.stderr.isatty()))
         result = run_patrol(args.robots, args.trials, args.seed, args.world, args.steps,
                             every_step_aat=args.aat == "every-step", progress=bar.update,
-                            record=record, video=video)
+                            functions=functions)
     if write_json(result, args.json):
         return 0
     alg2, base = result["aat_robots"], result["aat_every_step"]  # robots' AAT, shadow

@@ -84,7 +84,7 @@ def run_embodied(args) -> dict:
         if args.video:
             video = Video(outputs.enter_context(atomic_output(args.video, "video")),
                           area(spec.vertices.values()), check_video(args),
-                          marks=run.dropped_beacons, title=f"{spec.name}, {args.robots} robots")
+                          title=f"{spec.name}, {args.robots} robots")
             run.loop.add(video)
         with filming(video, run.recorder):
             try:

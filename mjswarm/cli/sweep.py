@@ -76,7 +76,7 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     from mjswarm.cli import check_seeds
-    from mjswarm.outputs.sweep import ResultsFile, grid, sweep
+    from mjswarm.experiments.sweep import ResultsFile, grid, sweep
 
     seeds = _ints(args.seeds, "--seeds")
     check_seeds(seeds, "--seeds")

@@ -7,8 +7,27 @@ checks is one event, and it counts again only after it has separated.
 
 from __future__ import annotations
 
+import re
+
 import mujoco
 import numpy as np
+
+
+#: How a contact event reads in a recording's event log (``mjswarm plot`` parses it back).
+CONTACT_EVENT = "contact {a}-{b} at ({x:.3f}, {y:.3f}) m"
+CONTACT_PATTERN = re.compile(r"contact (R\d+)-(R\d+) at \((-?[\d.]+), (-?[\d.]+)\) m")
+
+
+def contact_event(i: int, j: int, poses: np.ndarray) -> str:
+    """The event text of a contact between robots ``i`` and ``j`` (0-based), placed at the
+    midpoint of their positions (``poses``: (N, 3) in m)."""
+    x, y = (poses[i, :2] + poses[j, :2]) / 2.0
+    return CONTACT_EVENT.format(a=robot_name(i), b=robot_name(j), x=x, y=y)
+
+
+def robot_name(i: int) -> str:
+    """The name users see for 0-based robot index ``i``: R1, R2, ..."""
+    return f"R{i + 1}"
 
 
 class CollisionCounter:

@@ -6,7 +6,7 @@ robot is heard by every robot within range d_c of it, and it arrives within one 
 which here is exactly one control tick. On top of that the radio can drop each copy of a
 message with probability ``drop_prob`` (seeded numpy Generator) and can block a link when
 line of sight is lost (an injected, vectorised :data:`Blocker`: the embodied world passes
-:func:`mjswarm.experiments.awareness.sight_blocker`, the static harness :func:`walls_blocker`). Per-robot counters give the
+:func:`sight_blocker`, the static harness :func:`walls_blocker`). Per-robot counters give the
 papers' message complexities.
 
 One control tick, as the world or the harness drives it::
@@ -44,14 +44,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import networkx as nx
 import numpy as np
 from scipy.spatial import cKDTree
 
-from algorithms.robot import Message
+from algorithms.robot import NOTHING, Message
 from mjswarm.errors import MjswarmError
+
+if TYPE_CHECKING:  # the embodied worlds' radio model (sight_blocker) asks the simulation
+    from mjswarm.core.simulation import Simulation
 
 #: ``blocked(pairs) -> mask``: for an (M, 2) array of robot-id pairs ``(i, j)`` (int64 when
 #: every id is an int, else objects), a bool array with one entry per pair, True when i and
@@ -362,7 +365,7 @@ def walls_blocker(
     positions of robots i and j (read from ``positions`` at call time, metres, x and y) meets
     any wall segment, touching included (the orientation test with collinear-overlap cases),
     computed for all pairs x walls at once by numpy broadcasting. The embodied world uses
-    :func:`mjswarm.experiments.awareness.sight_blocker` instead.
+    :func:`sight_blocker` instead.
     """
     w = np.asarray([(a[0], a[1], b[0], b[1]) for a, b in walls], dtype=float).reshape(-1, 4)
     c, d = w[None, :, 0:2], w[None, :, 2:4]  # (1, walls, 2)
@@ -397,5 +400,38 @@ def walls_blocker(
             | ((d4 == 0) & on_segment(a, b, d))
         )
         return np.any(proper | touch, axis=1)
+
+    return blocked
+
+
+def sight_blocker(sim: Simulation, fixed: Mapping[Hashable, tuple[float, float]] = NOTHING,
+                  mast_m: float = 0.0) -> Blocker:
+    """The radio's line-of-sight test on a simulation: a link between robots i and j is
+    blocked unless each sees the other (:attr:`Simulation.sight` both ways); a link
+    between a robot and a fixed node (a base station at ``fixed[address]``, m, its antenna
+    ``mast_m`` above the floor, or a robot docked at it) unless the robot is seen from the
+    antenna; two fixed nodes always link."""
+
+    def between_robots(pairs: np.ndarray) -> np.ndarray:
+        i, j = np.asarray(pairs, np.int64).reshape(-1, 2).T
+        seen = sim.sight(i, j)  # the way back only where the way there is clear
+        seen[seen] = sim.sight(j[seen], i[seen])
+        return ~seen
+
+    if not fixed:
+        return between_robots
+
+    def blocked(pairs: np.ndarray) -> np.ndarray:
+        pairs = np.asarray(pairs).reshape(-1, 2)
+        cut = np.zeros(len(pairs), bool)
+        robots = np.array([not (a in fixed or b in fixed) for a, b in pairs], bool)
+        if robots.any():
+            cut[robots] = between_robots(pairs[robots])
+        for k in np.flatnonzero(~robots):
+            a, b = pairs[k]
+            node, robot = (a, b) if a in fixed else (b, a)
+            if robot not in fixed:  # two masts see each other
+                cut[k] = not sim.sight.from_point(fixed[node], [robot], mast_m)[0]
+        return cut
 
     return blocked

@@ -43,9 +43,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from contextlib import ExitStack
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -56,8 +54,6 @@ from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.openfloor import EmbodiedFloor, MotionWorld, PointWorld
 from mjswarm.core.robot import spark_v_geometry
 from mjswarm.core.radio import Radio
-from mjswarm.outputs.recording import Recorder, Recording
-from mjswarm.outputs.video import Video, filming
 
 MAX_ROBOTS = 10
 START_ROBOTS = 5
@@ -127,15 +123,14 @@ class CoverageRun(LoopFunctions):
         region_diameter_m: D, the diameter of every region (m).
         max_ticks: an episode that has not settled by then raises :class:`MjswarmError`.
         clearance_m: distance robots keep (m); default ``CLEARANCE_M`` embodied, 0 points.
-        recorder: a :class:`~mjswarm.outputs.recording.Recorder` for ``MAX_ROBOTS`` robots without
-            sensors (:func:`recorder_for`), or None.
-        functions: more loop functions (e.g. a :class:`~mjswarm.outputs.video.Video`),
-            hooked in before the team is built.
+        functions: more loop functions that watch the run (a recording, a video: the
+            caller makes and closes them; the episodes reach them as
+            :meth:`~mjswarm.worlds.loop.Loop.event` s), hooked in before the team is built.
     """
 
     def __init__(self, cr: float, placement: str = "heuristic", world: str = "point",
                  seed: int = 0, region_diameter_m: float = 1.0, max_ticks: int = 20_000,
-                 clearance_m: float | None = None, recorder: Recorder | None = None,
+                 clearance_m: float | None = None,
                  functions: Sequence[LoopFunctions] = ()) -> None:
         if not (math.isfinite(cr) and cr > 1.0):
             raise MjswarmError(f"cr must be a number above 1, got {cr}")
@@ -170,9 +165,7 @@ class CoverageRun(LoopFunctions):
             self.world = EmbodiedFloor(starts, present=absent, seed=seed,
                                        floor_half_size_m=half, control_dt_s=tick)
         self.world.attach_radio(Radio(range(MAX_ROBOTS), range_m=self.params.link_m))
-        self.recording = Recording(recorder) if recorder is not None else None
-        self.loop = Loop(self.world, {}, [self] + ([self.recording] if self.recording else [])
-                         + list(functions))
+        self.loop = Loop(self.world, {}, [self, *functions])
         self._ticks, self._running = 0, ""
         for _ in range(START_ROBOTS):
             self._episode("add", -1)
@@ -226,8 +219,7 @@ class CoverageRun(LoopFunctions):
             radio.step()
             world.place(robot, None)
             self.minds.pop(robot)
-        if self.recording is not None:
-            self.recording.event(self.loop, f"episode {index}: {action} R{robot + 1}", robot)
+        self.loop.event(f"episode {index}: {action} R{robot + 1}", robot)
         before = {k: (m.moves_led, m.checks_led) for k, m in self.minds.items()}
         self._ticks, self._running = 0, f"episode {index} ({action} robot {robot})"
         self.loop.run()
@@ -281,30 +273,16 @@ def area(cr: float, region_diameter_m: float = 1.0) -> tuple[float, float, float
     return (-half, -half, half, half)
 
 
-def recorder_for(path: str | Path, cr: float, world: str, region_diameter_m: float = 1.0,
-                 video: bool = False) -> Recorder:
-    """A recorder for a coverage run: ``MAX_ROBOTS`` robots, radios, no arena."""
-    return Recorder(path, None, MAX_ROBOTS, radio=True, sensors=False, video=video,
-                    bounds_m=area(cr, region_diameter_m),
-                    name=f"biconnected coverage, cr {cr:g}, {world} world")
-
-
 def run_coverage(cr: float, placement: str = "heuristic", episodes: int = 100,
                  seed: int = 0, world: str = "embodied", region_diameter_m: float = 1.0,
                  progress: Callable[[], None] | None = None,
-                 record: str | Path | None = None, video: Video | None = None) -> CoverageResult:
-    """Build the team of 5 and run ``episodes`` random add / remove episodes; with
-    ``record``, write a rerun recording there; with ``video``, film the run."""
+                 functions: Sequence[LoopFunctions] = ()) -> CoverageResult:
+    """Build the team of 5 and run ``episodes`` random add / remove episodes, watched by
+    ``functions`` (a recording, a video)."""
     if episodes < 1:
         raise MjswarmError(f"need at least one episode, got {episodes}")
-    extra = [video] if video is not None else []
-    with ExitStack() as outputs:
-        recorder = None if record is None else outputs.enter_context(
-            recorder_for(record, cr, world, region_diameter_m, video is not None))
-        run = CoverageRun(cr, placement, world, seed, region_diameter_m, recorder=recorder,
-                          functions=extra)
-        with filming(video, recorder):
-            return run.run(episodes, progress)
+    run = CoverageRun(cr, placement, world, seed, region_diameter_m, functions=functions)
+    return run.run(episodes, progress)
 
 
 __all__ = ["CoverageResult", "CoverageRun", "Episode", "run_coverage"]

@@ -90,18 +90,18 @@ from algorithms.navigation import NavigatorState
 from mjswarm.arena import ArenaSpec
 from mjswarm.arena.builder import arena_world_spec
 from mjswarm.arena.geometry import LANE_OFFSET_M, VERTEX_CLEAR_RADIUS_M
-from mjswarm.experiments.awareness import BICONNECTED, NOT, sight_blocker
+from mjswarm.experiments.awareness import BICONNECTED, NOT
 from mjswarm.experiments.awareness import truth as awareness_truth
 from mjswarm.core.bearing import BearingSensor
+from mjswarm.core.contacts import contact_event
 from mjswarm.core.robot import spark_v_geometry
 from mjswarm.errors import MjswarmError, RunInterrupted
 from mjswarm.experiments.faults import Fault, check_fault, is_user_fault
 from mjswarm.worlds.graphworld import ExplorationResult, make_minds, outcome
 from mjswarm.worlds.radiograph import CONNECTIVITY, NEED, infeasible_reason, need_robots
-from mjswarm.outputs.recording import contact_event
-from mjswarm.worlds.loop import Loop, LoopFunctions
+from mjswarm.worlds.loop import Loop, LoopFunctions, Scene
 from mjswarm.worlds.navigation import calibration, conventions
-from mjswarm.core.radio import Radio, Uplink
+from mjswarm.core.radio import Radio, Uplink, sight_blocker
 from mjswarm.core.simulation import Simulation
 from mjswarm.worlds.sparkworld import SparkWorld
 from mjswarm.experiments.stations import VertexStations
@@ -117,6 +117,8 @@ TURN_RESERVE_M = 2 * LANE_OFFSET_M + 0.02
 #: Height (m) of the base station's antenna at the root: above the robots (0.07 m tall),
 #: so that a robot standing on the root does not shadow the others; walls still block.
 BASE_MAST_M = 1.0
+#: What pictures of a run say the marked vertices are.
+BEACON_LABEL = "beacon dropped (vertex explored)"
 #: A robot is on a vertex when within this distance of its centre (m).
 ON_VERTEX_M = 0.05
 #: The root counts as free for a launch when no active robot is this close to it (m).
@@ -544,9 +546,10 @@ class EmbodiedExploration(LoopFunctions):
     def should_stop(self, loop: Loop) -> bool:
         return self.finished()
 
-    def dropped_beacons(self) -> list[tuple[float, float]]:
-        """Where beacons have been dropped so far (m): the vertices a video marks."""
-        return [self.spec.vertices[v] for v, b in self.beacons.items() if b.id is not None]
+    def scene(self, loop: Loop) -> Scene:
+        """Pictures mark the vertices whose beacon has been dropped (m)."""
+        return Scene([self.spec.vertices[v] for v, b in self.beacons.items()
+                      if b.id is not None], BEACON_LABEL)
 
     # ------------------------------------------------------------------ stations
     def _beacon_at(self, i: int) -> Beacon | None:

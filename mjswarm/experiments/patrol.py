@@ -34,10 +34,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
-from contextlib import ExitStack
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 
 import networkx as nx
 import numpy as np
@@ -53,11 +51,9 @@ from algorithms.maintenance.roles import (
 )
 from algorithms.robot import Command, Controller, Observation
 from mjswarm.errors import MjswarmError
-from mjswarm.worlds.loop import Loop, LoopFunctions
+from mjswarm.worlds.loop import Loop, LoopFunctions, Scene
 from mjswarm.worlds.openfloor import EmbodiedFloor, MotionWorld, PointWorld
 from mjswarm.core.radio import Radio
-from mjswarm.outputs.recording import Recorder, Recording
-from mjswarm.outputs.video import Video, filming
 
 #: Duration of one paper timestep (s): 0.03 m/step = 0.2 m/s, 0.15 rad/step = 1 rad/s.
 STEP_S = 0.15
@@ -202,12 +198,16 @@ class PatrolMission(LoopFunctions):
         self.history: dict[str, list] = {"positions": [], "roles": [], "edges": []}
         self._flock_base = nx.Graph()
         self._acted_from = np.zeros((robots, 2))  # true positions at the tick's start
-        self.recording: Recording | None = None
         self._roles = [m.role for m in minds]
 
-    def _event(self, loop: Loop, text: str, robot: int | None = None) -> None:
-        if self.recording is not None:
-            self.recording.event(loop, text, robot)
+    def scene(self, loop: Loop) -> Scene:
+        """Pictures show the base station's target, the network's links (mutual
+        connections no longer than d_c) and each robot's role."""
+        xy = loop.world.true_positions()
+        graph = network_graph(self.minds, xy, self.params.d_c)
+        return Scene([self.minds[0].target.x], "target (of the leader)",
+                     [(xy[a], xy[b]) for a, b in graph.edges],
+                     [m.role.value for m in self.minds])
 
     def new_target(self, seq: int) -> Target:
         """A target drawn in the target square (the simulator informs the base station)."""
@@ -263,11 +263,11 @@ class PatrolMission(LoopFunctions):
         if base_station.target is not None and base_station.arrived >= base_station.target.seq:
             self.targets += 1
             base_station.target = self.new_target(base_station.target.seq + 1)
-            self._event(loop, f"target {self.targets} reached; next at "
+            loop.event(f"target {self.targets} reached; next at "
                               f"({base_station.target.x[0]:.2f}, {base_station.target.x[1]:.2f}) m")
         for i, m in enumerate(minds):
             if m.role is not self._roles[i]:
-                self._event(loop, f"R{i + 1}: {self._roles[i].value} -> {m.role.value}", i)
+                loop.event(f"R{i + 1}: {self._roles[i].value} -> {m.role.value}", i)
                 self._roles[i] = m.role
         if self.progress is not None:
             self.progress(1)
@@ -276,12 +276,12 @@ class PatrolMission(LoopFunctions):
 def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
               params: RoleParams | None = None, every_step_aat: bool = False,
               sample_every: int = 10, progress: Callable[[int], None] | None = None,
-              keep_history: bool = False, recorder: Recorder | None = None,
-              video: Video | None = None) -> TrialResult:
+              keep_history: bool = False,
+              functions: Sequence[LoopFunctions] = ()) -> TrialResult:
     """One patrol mission of ``steps`` timesteps with ``robots`` robots (base station
     included). ``every_step_aat`` drives the robots with the baseline instead of
-    Algorithm 2; ``recorder`` (:func:`recorder_for`) records the mission and ``video``
-    films it (the caller closes both)."""
+    Algorithm 2; ``functions`` are more loop functions that watch the mission (a
+    recording, a video: the caller makes them, hands them in and closes them)."""
     params = params or RoleParams()
     if steps < 1 or sample_every < 1:
         raise MjswarmError("steps and sample interval must be at least 1")
@@ -300,13 +300,7 @@ def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
     floor = make_world(world, xy0, seed, params.d_s)
     floor.attach_radio(Radio(range(robots), range_m=params.d_c, rng=seed))
     timed = [Timed(m) for m in minds]
-    functions: list[LoopFunctions] = [mission]
-    if recorder is not None:
-        mission.recording = Recording(recorder)
-        functions.append(mission.recording)
-    if video is not None:
-        functions.append(_shows_mission(video, minds, floor, params.d_c))
-    loop = Loop(floor, dict(enumerate(timed)), functions)
+    loop = Loop(floor, dict(enumerate(timed)), [mission, *functions])
     loop.run(max_ticks=steps)
     robot_steps = robots * steps
     cpu_by_role: dict[str, list[float]] = {r.value: [0.0, 0] for r in Role}
@@ -339,19 +333,6 @@ def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
         wall_s=time.perf_counter() - started,
         history=mission.history if keep_history else {},
     )
-
-
-def _shows_mission(video: Video, minds: list[RoleSwitchingRobot], floor: MotionWorld,
-                   d_c: float) -> Video:
-    """``video``, told to show the base station's target, the network's links (mutual
-    connections no longer than ``d_c``, m) and each robot's role."""
-    def links():
-        xy = floor.true_positions()
-        return [(xy[a], xy[b]) for a, b in network_graph(minds, xy, d_c).edges]
-
-    video.marks, video.marks_label = (lambda: [minds[0].target.x]), "target (of the leader)"
-    video.links, video.notes = links, (lambda: [m.role.value for m in minds])
-    return video
 
 
 def summarize(trials: list[TrialResult]) -> dict:
@@ -396,33 +377,20 @@ def area(robots: int) -> tuple[float, float, float, float]:
     return (0.0, 0.0, side, side)
 
 
-def recorder_for(path: str | Path, robots: int, world: str, video: bool = False) -> Recorder:
-    """A recorder for one mission: the robots, their radios, the target square."""
-    return Recorder(path, None, robots, radio=True, sensors=False, bounds_m=area(robots),
-                    name=f"patrol, N = {robots}, {world} world", video=video)
-
-
 def run_patrol(robots: int, trials: int = 1, seed: int = 0, world: str = "embodied",
                steps: int = 2000, params: RoleParams | None = None,
                every_step_aat: bool = False,
                progress: Callable[[int], None] | None = None,
-               record: str | Path | None = None, video: Video | None = None) -> dict:
+               functions: Sequence[LoopFunctions] = ()) -> dict:
     """``trials`` missions (seeds ``seed .. seed + trials - 1``), summarised; with
-    ``record`` (a rerun recording) or ``video``, of the single mission."""
+    ``functions`` (loop functions that watch a mission: a recording, a video), of the
+    single mission."""
     if trials < 1:
         raise MjswarmError(f"need at least one trial, got {trials}")
     if world not in WORLDS:
         raise MjswarmError(f"unknown world {world!r} (choose from {', '.join(WORLDS)})")
-    if record is not None or video is not None:
-        if trials != 1:
-            raise MjswarmError(f"a recording or video holds one mission; got {trials} trials")
-        with ExitStack() as outputs:
-            recorder = None if record is None else outputs.enter_context(
-                recorder_for(record, robots, world, video is not None))
-            with filming(video, recorder):
-                return summarize([run_trial(robots, seed, world, steps, params,
-                                            every_step_aat, progress=progress,
-                                            recorder=recorder, video=video)])
+    if functions and trials != 1:
+        raise MjswarmError(f"a recording or video holds one mission; got {trials} trials")
     results = [run_trial(robots, seed + k, world, steps, params, every_step_aat,
-                         progress=progress) for k in range(trials)]
+                         progress=progress, functions=functions) for k in range(trials)]
     return summarize(results)

@@ -35,7 +35,8 @@ import pyarrow as pa  # noqa: E402
 import rerun as rr  # noqa: E402
 
 from mjswarm.errors import MjswarmError, one_line  # noqa: E402
-from mjswarm.outputs.recording import CONTACT_PATTERN, robot_color  # noqa: E402
+from mjswarm.core.contacts import CONTACT_PATTERN  # noqa: E402
+from mjswarm.outputs.recording import robot_color  # noqa: E402
 
 #: A stretch of trajectory that spans less than this (m) is a robot parked in a depot.
 PARKED_M = 0.02

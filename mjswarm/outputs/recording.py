@@ -58,7 +58,6 @@ from __future__ import annotations
 
 import colorsys
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -76,6 +75,7 @@ from mjswarm.arena.builder import arena_primitives
 from mjswarm.arena.spec import ArenaSpec
 from mjswarm.errors import MjswarmError, one_line
 from mjswarm.worlds.loop import Loop, LoopFunctions
+from mjswarm.core.contacts import contact_event, robot_name
 from mjswarm.core.robot import ENCODERS, IR_SENSORS, LINE_SENSORS
 
 if TYPE_CHECKING:
@@ -100,23 +100,6 @@ _ROOT_COLOR = (240, 190, 20, 255)
 _AGREE_COLOR = (40, 170, 60, 255)
 _DISAGREE_COLOR = (220, 40, 40, 255)
 _NO_BELIEF_COLOR = (140, 140, 140, 255)
-
-
-#: How a contact event reads in a recording's event log (``mjswarm plot`` parses it back).
-CONTACT_EVENT = "contact {a}-{b} at ({x:.3f}, {y:.3f}) m"
-CONTACT_PATTERN = re.compile(r"contact (R\d+)-(R\d+) at \((-?[\d.]+), (-?[\d.]+)\) m")
-
-
-def contact_event(i: int, j: int, poses: np.ndarray) -> str:
-    """The event text of a contact between robots ``i`` and ``j`` (0-based), placed at the
-    midpoint of their positions (``poses``: (N, 3) in m)."""
-    x, y = (poses[i, :2] + poses[j, :2]) / 2.0
-    return CONTACT_EVENT.format(a=robot_name(i), b=robot_name(j), x=x, y=y)
-
-
-def robot_name(i: int) -> str:
-    """The name users see for 0-based robot index ``i``: R1, R2, ..."""
-    return f"R{i + 1}"
 
 
 def robot_color(i: int) -> tuple[int, int, int, int]:
@@ -720,6 +703,7 @@ class Recording(LoopFunctions):
         if world.radio is not None and step % self.radio_every == 0:
             rec.log_radio(step, now, [tuple(e) for e in world.radio.graph().edges])
 
-    def event(self, loop: Loop, text: str, robot: int | None = None) -> None:
-        """An experiment's event, at the current tick."""
+    def on_event(self, loop: Loop, text: str, robot: int | None) -> None:
+        """An experiment's event (:meth:`~mjswarm.worlds.loop.Loop.event`), at the
+        current tick."""
         self.recorder.log_event(loop.ticks, loop.world.time_s, text, robot)

@@ -44,8 +44,9 @@ from PIL import Image, ImageDraw, ImageFont
 
 import mjswarm
 from mjswarm.errors import MjswarmError, one_line
-from mjswarm.outputs.recording import robot_color, robot_name
-from mjswarm.worlds.loop import Loop, LoopFunctions
+from mjswarm.core.contacts import robot_name
+from mjswarm.outputs.recording import robot_color
+from mjswarm.worlds.loop import Loop, LoopFunctions, Scene
 
 #: Frames per second of video.
 FPS = 30
@@ -66,9 +67,6 @@ OVERLAY_Z_M = 0.006
 MARK_RGBA = (0.95, 0.75, 0.1, 1.0)
 #: Radius of a mark on the floor, as a fraction of the framed width (at least 4 cm).
 MARK_RADIUS = 0.015
-#: What the marks are unless the caller says: :mod:`mjswarm.cli.explore` marks the vertices
-#: whose beacon has been dropped.
-BEACON_LABEL = "beacon dropped (vertex explored)"
 #: Colour of radio links (RGB).
 LINK_RGB = (40, 90, 220)
 #: Height of the band at the top of every frame, which holds the title and time (pixels).
@@ -258,25 +256,20 @@ class Video(LoopFunctions):
             (:func:`camera_for` the loop's world) is made when the loop starts.
         speedup: simulated seconds per second of video.
         fps: frames per second of video.
-        marks: ``marks()`` gives the points (m) to mark on the next frame, or None.
-        marks_label: what the marks are, for the legend.
-        links: ``links()`` gives the radio links ((x, y), (x, y)) (m) to draw, or None.
-        notes: ``notes()`` gives a word per robot (e.g. its role) written after its name.
         title: written on every frame before the time.
+
+    What else a frame shows comes from the other loop functions' scenes
+    (:meth:`~mjswarm.worlds.loop.LoopFunctions.scene`): points to mark (with what they
+    are, in the legend), radio links, a word per robot written after its name.
     """
 
     def __init__(self, path: str | Path, bounds_m: Sequence[float],
-                 speedup: float = DEFAULT_SPEEDUP, fps: int = FPS,
-                 marks: Callable[[], Sequence[tuple[float, float]]] | None = None,
-                 title: str = "", marks_label: str = BEACON_LABEL,
-                 links: Callable[[], Sequence[Sequence[tuple[float, float]]]] | None = None,
-                 notes: Callable[[], Sequence[str]] | None = None) -> None:
+                 speedup: float = DEFAULT_SPEEDUP, fps: int = FPS, title: str = "") -> None:
         if not (math.isfinite(speedup) and speedup > 0):
             raise MjswarmError(f"video speed-up must be a positive number, got {speedup}")
         self.path, self.bounds_m, self.speedup, self.fps = Path(path), bounds_m, speedup, fps
         self.camera: Camera | None = None
-        self.marks, self.marks_label, self.title = marks, marks_label, title
-        self.links, self.notes = links, notes
+        self.title = title
         #: simulated time (s) of each frame drawn so far
         self.frame_times_s: list[float] = []
         self._next_s = 0.0
@@ -308,10 +301,11 @@ class Video(LoopFunctions):
                 del trail[:-TRAIL_FRAMES]
             else:
                 trail.clear()
-        marks = list(self.marks()) if self.marks is not None else []
+        scenes = loop.scenes()
+        marks = [xy for scene in scenes for xy in scene.marks]
         image = self.camera(poses, [np.array(t).reshape(-1, 2) for t in self._trails], marks)
         picture = Image.fromarray(image)
-        self._annotate(ImageDraw.Draw(picture), world, poses)
+        self._annotate(ImageDraw.Draw(picture), world, poses, scenes)
         frame = np.ascontiguousarray(np.asarray(picture))
         if self._writer is None:  # the frame size is known now
             self._writer = imageio_ffmpeg.write_frames(
@@ -323,22 +317,24 @@ class Video(LoopFunctions):
         self.frame_times_s.append(world.time_s)
         self._next_s = len(self.frame_times_s) * self.frame_interval_s
 
-    def _annotate(self, draw: ImageDraw.ImageDraw, world, poses: np.ndarray) -> None:
+    def _annotate(self, draw: ImageDraw.ImageDraw, world, poses: np.ndarray,
+                  scenes: Sequence[Scene]) -> None:
         """Links, vertex and robot names, scale bar, legend and title over a frame."""
         to_pixels = self.camera.to_pixels
-        links = list(self.links()) if self.links is not None else []
+        links = [link for scene in scenes for link in scene.links]
         for a, b in links:
             draw.line([tuple(p) for p in to_pixels([a, b])], fill=LINK_RGB, width=2)
         for name, (col, row) in zip(self.camera.labels,
                                     to_pixels(list(self.camera.labels.values()))):
             draw.text((col + 5, row - 14), name, fill=(90, 90, 90), font=self._small)
-        notes = list(self.notes()) if self.notes is not None else [""] * world.n
+        notes = next((list(sc.notes) for sc in scenes if sc.notes is not None), [""] * world.n)
         on_floor = np.flatnonzero(world.present)
         for i, (col, row) in zip(on_floor, to_pixels(poses[on_floor, :2])):
             draw.text((col + 9, row - 8), f"{robot_name(i)} {notes[i]}".strip(), fill="black",
                       font=self._small, stroke_width=2, stroke_fill="white")
         self._scale_bar(draw)
-        self._legend(draw, world, notes, bool(links))
+        self._legend(draw, world, notes, [sc.marks_label for sc in scenes if sc.marks_label],
+                     bool(links))
         text = f"{self.title}  t = {world.time_s:7.1f} s  ({self.speedup:g}x)".strip()
         draw.rectangle((0, 0, draw.im.size[0], TITLE_PX), fill=(255, 255, 255))
         draw.text((8, 4), text, fill=(0, 0, 0), font=self._font)
@@ -357,7 +353,7 @@ class Video(LoopFunctions):
                   font=self._small, anchor="ma", stroke_width=2, stroke_fill="white")
 
     def _legend(self, draw: ImageDraw.ImageDraw, world, notes: Sequence[str],
-                links: bool) -> None:
+                marks: Sequence[str], links: bool) -> None:
         """Each robot's colour and name (and where it is when off the floor), then the
         marks and the radio links, in a box at the top right."""
         entries = []  # (swatch: "dot" or "line", RGB, text)
@@ -368,9 +364,8 @@ class Video(LoopFunctions):
                             + where))
         if world.n > LEGEND_ROBOTS:
             entries.append(("", None, f"... {robot_name(world.n - 1)}: {world.n} robots"))
-        if self.marks is not None:
-            entries.append(("dot", tuple(int(255 * c) for c in MARK_RGBA[:3]),
-                            self.marks_label))
+        for label in marks:
+            entries.append(("dot", tuple(int(255 * c) for c in MARK_RGBA[:3]), label))
         if links:
             entries.append(("line", LINK_RGB, "radio link"))
         line_px = 16

@@ -37,7 +37,7 @@ from __future__ import annotations
 import gc
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -174,8 +174,26 @@ class World(ABC):
                 self.radio.send(i, m.payload, m.to)
 
 
+class Scene(NamedTuple):
+    """What a loop function shows on pictures of the run (ground truth, for outputs):
+    points to mark (m) and what they are, radio links to draw (pairs of points, m), and a
+    word per robot (its role, say), or None."""
+
+    marks: Sequence[tuple[float, float]] = ()
+    marks_label: str = ""
+    links: Sequence[tuple[tuple[float, float], tuple[float, float]]] = ()
+    notes: Sequence[str] | None = None
+
+
 class LoopFunctions:
-    """Hooks the loop calls; override the ones an experiment needs (all optional)."""
+    """Hooks the loop calls; override the ones an experiment needs (all optional).
+
+    Besides the hooks of a tick, loop functions talk to each other through the loop, so
+    that an experiment never needs to know what records or films it: :meth:`Loop.event`
+    hands an experiment's event (a line of text, about a robot or the run) to every loop
+    function's :meth:`on_event`, and pictures ask every loop function for its
+    :meth:`scene`.
+    """
 
     def initialize(self, loop: Loop) -> None:
         """Before the first tick: place robots, set up stations, radios, recorders."""
@@ -189,6 +207,13 @@ class LoopFunctions:
     def should_stop(self, loop: Loop) -> bool:
         """Whether the run is over."""
         return False
+
+    def on_event(self, loop: Loop, text: str, robot: int | None) -> None:
+        """Another loop function's event (see :meth:`Loop.event`), e.g. to record it."""
+
+    def scene(self, loop: Loop) -> Scene | None:
+        """What to show on a picture of the run now (None: nothing)."""
+        return None
 
     def result(self, loop: Loop) -> Any:
         """What the run measured (the experiment's result object)."""
@@ -231,6 +256,16 @@ class Loop:
     def stop(self) -> None:
         """End the run after the current tick (from a hook)."""
         self._stop = True
+
+    def event(self, text: str, robot: int | None = None) -> None:
+        """An experiment's event (``robot``: the one it is about, or None for the run):
+        every loop function hears it (:meth:`LoopFunctions.on_event`)."""
+        for f in self.functions:
+            f.on_event(self, text, robot)
+
+    def scenes(self) -> list[Scene]:
+        """What the loop functions show on a picture of the run now."""
+        return [s for f in self.functions if (s := f.scene(self)) is not None]
 
     def step(self) -> None:
         """One control tick (module docstring)."""

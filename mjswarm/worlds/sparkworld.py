@@ -6,7 +6,7 @@ observes its own rangefinders, encoders, wheel speeds and battery (the simulatio
 sensor record), the bearings its :class:`~mjswarm.core.bearing.BearingSensor` reports, its
 radio, and the beacon under it when the loop functions keep beacons (``beacon_at``);
 its ``(v, omega)`` command goes to the wheels through the model's motors. The radio's
-links need line of sight both ways (:func:`mjswarm.experiments.awareness.sight_blocker`).
+links need line of sight both ways (:func:`mjswarm.core.radio.sight_blocker`).
 
 Every robot is on the floor unless a loop function says otherwise (``present``: robots
 waiting in a depot off the arena are neither stepped nor on the air).

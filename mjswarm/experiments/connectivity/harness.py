@@ -3,7 +3,7 @@
 Each tick every robot (in team order) reads its inbox, sees its neighbours and answers
 with messages to send, which the radio delivers at the end of the tick; one tick is the
 papers' c. The robots are :class:`~algorithms.connectivity.participant.Participant`
-controllers in a :class:`StaticWorld`, run by the one :class:`~mjswarm.worlds.loop.Loop`. The harness counts messages from the radio's counters and stops at the deciding robot's
+controllers in a :class:`~mjswarm.worlds.static.StaticWorld`, run by the one :class:`~mjswarm.worlds.loop.Loop`. The harness counts messages from the radio's counters and stops at the deciding robot's
 decision: the initiator (``stamps``, seed 002 Algorithm 3: tick 6N + 2 at the latest) or
 the reference (``tables`` / ``tables-2``, seed 004 with the gathering of
 :class:`algorithms.connectivity.TableCheck`: tick 2N - 1).
@@ -19,14 +19,12 @@ from __future__ import annotations
 from collections.abc import Callable, Hashable, Mapping
 from dataclasses import asdict, dataclass
 
-import numpy as np
-
 from algorithms.connectivity import BiconnectivityCheck, TableCheck
 from algorithms.connectivity.participant import MessagePassing, Participant
-from algorithms.robot import Command, Observation
 from mjswarm.experiments.connectivity.team import Team
 from mjswarm.errors import MjswarmError
-from mjswarm.worlds.loop import Loop, LoopFunctions, World
+from mjswarm.worlds.loop import Loop, LoopFunctions
+from mjswarm.worlds.static import StaticWorld
 from mjswarm.core.radio import Radio
 
 #: Method names: seed 002's stamps, seed 004's tables and its forward-two variant.
@@ -61,44 +59,6 @@ class CheckResult:
         return asdict(self)
 
 
-class StaticWorld(World):
-    """Robots that stand still and only talk: the harness's world. Robot ids are the
-    radio's (any hashables); one control tick is one time unit, the papers' c."""
-
-    def __init__(self, radio: Radio, start: int = 0) -> None:
-        self.radio = radio
-        self.ids = radio.robots
-        self.n = len(self.ids)
-        self.present = np.ones(self.n, bool)
-        self.control_dt_s = 1.0
-        self.uplinks = {}
-        self._now = start
-
-    @property
-    def time_s(self) -> float:
-        return float(self._now)
-
-    def true_poses(self) -> np.ndarray:
-        return np.zeros((self.n, 3))
-
-    def active(self) -> list[Hashable]:
-        return list(self.radio.present)
-
-    def commanded_speeds(self) -> np.ndarray:
-        return np.zeros(self.n)
-
-    def observe(self, i: Hashable) -> Observation:
-        inbox, neighbors = self._inbox(i)
-        return Observation(i, self.time_s, inbox=inbox, neighbors=neighbors)
-
-    def act(self, i: Hashable, command: Command) -> None:
-        self._send(i, command.messages)
-
-    def step(self) -> None:
-        self.radio.step()
-        self._now += 1
-
-
 class _Until(LoopFunctions):
     """Stops the harness when ``until()`` holds after a tick, or once more than ``cap``
     messages were sent (checked after each tick: a tick adds at most one round of
@@ -127,7 +87,7 @@ def drive(
 
     ``robots`` maps radio ids to message-passing minds (``tick(now, inbox, neighbors)``),
     each run as a :class:`~algorithms.connectivity.participant.Participant` by one
-    :class:`~mjswarm.worlds.loop.Loop` in a :class:`StaticWorld`. A tick's messages are
+    :class:`~mjswarm.worlds.loop.Loop` in a :class:`~mjswarm.worlds.static.StaticWorld`. A tick's messages are
     delivered at its end (``radio.last_batch`` counts them). Returns ``(last tick,
     capped)``; capped means more than ``message_cap`` messages were sent (checked after
     each tick).

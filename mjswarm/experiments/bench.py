@@ -1,10 +1,10 @@
 """Benchmark: the full mjswarm step against bare ``mj_step`` on the same world.
 
-For each robot count N the benchmark builds one world (robots in a grid, each on its own
-floor strip, walls beside every row) and measures, in the same process and run:
+For each robot count N the benchmark builds one world (:func:`mjswarm.worlds.bench.bench_world`:
+robots in a grid, each on its own floor strip, walls beside every row) and measures, in the same process and run:
 
 * ``realtime_factor``: simulated seconds per wall second of the full control loop
-  (:func:`bench_loop`: one :class:`BenchRobot` controller per robot in a
+  (:func:`bench_loop`: one :class:`~algorithms.bench_robot.BenchRobot` controller per robot in a
   :class:`~mjswarm.worlds.sparkworld.SparkWorld`, run by the one :class:`~mjswarm.worlds.loop.Loop`): every robot's line, IR, encoder and wheel-speed readings, its
   bearing sensor (+-60 degrees, 1 m, line of sight), a radio (range ``RADIO_RANGE_M``,
   links need line of sight both ways) on which every robot broadcasts a heartbeat every
@@ -23,36 +23,27 @@ slow spells (this one is a shared virtual machine) fall on both alike.
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import asdict, dataclass
 
 import mujoco
 import numpy as np
 
+from algorithms.bench_robot import BenchRobot
 from algorithms.collision import CollisionRule, epsilons
-from algorithms.navigation.percept import LINE_THRESHOLD_M
-from algorithms.robot import Command, Controller, Message, Observation
-from mjswarm.experiments.awareness import sight_blocker
 from mjswarm.core.bearing import BearingSensor
-from mjswarm.errors import MjswarmError
-from mjswarm.worlds.loop import Loop
-from mjswarm.core.radio import Radio
+from mjswarm.core.radio import Radio, sight_blocker
 from mjswarm.core.robot import DEFAULT_ROBOT_XML
 from mjswarm.core.simulation import Simulation
+from mjswarm.errors import MjswarmError
+from mjswarm.worlds.bench import bench_world
+from mjswarm.worlds.loop import Loop
 from mjswarm.worlds.sparkworld import SparkWorld
-from mjswarm.core.world import FloorStrip, Pose2D, WallSegment, world_spec
 
-ROW_SPACING_M = 0.5
-COLUMN_SPACING_M = 0.6
 BENCH_SPEED_M_S = 0.1
 RADIO_RANGE_M = 1.0
-#: the line follower's turn rate when one side sensor sees the strip (rad/s)
-TURN_GAIN_RAD_S = 0.8
 #: stretches in which the full loop and bare physics take turns (:func:`run_bench`)
 BLOCKS = 8
-#: what every robot broadcasts every tick (a heartbeat carries nothing but its sender)
-HEARTBEAT = (Message("heartbeat"),)
 
 
 @dataclass(frozen=True)
@@ -67,42 +58,6 @@ class BenchResult:
     physics_only_realtime_factor: float
     overhead_ratio: float
     robot_steps_per_s: float
-
-
-def bench_world(n: int, robot_xml: str = str(DEFAULT_ROBOT_XML), sensing: str = "auto",
-                physics: str = "dynamic") -> Simulation:
-    """N robots in a near-square grid, each on a strip with a wall on its left."""
-    if n < 1:
-        raise MjswarmError(f"robot count must be >= 1, got {n}")
-    cols = math.ceil(math.sqrt(n))
-    rows = math.ceil(n / cols)
-    row_len = cols * COLUMN_SPACING_M + 2.0
-    poses = [Pose2D((i % cols) * COLUMN_SPACING_M, (i // cols) * ROW_SPACING_M) for i in range(n)]
-    strips = [FloorStrip((-0.5, r * ROW_SPACING_M), (row_len, r * ROW_SPACING_M)) for r in range(rows)]
-    walls = [
-        WallSegment((-0.5, r * ROW_SPACING_M + 0.13), (row_len, r * ROW_SPACING_M + 0.13))
-        for r in range(rows)
-    ]
-    return Simulation(world_spec(poses, strips, walls, robot_xml=robot_xml), sensing=sensing,
-                      physics=physics)
-
-
-class BenchRobot(Controller):
-    """The bench's controller: hears its inbox and broadcasts a heartbeat every tick,
-    sets its speed with the seed-003 speed rule from its bearings and steers towards the
-    darker side with a proportional line follower on its own line sensors."""
-
-    def __init__(self, rule: CollisionRule, line_sensor_height_m: float) -> None:
-        self.rule = rule
-        self.height_m = line_sensor_height_m
-        self.heard = 0
-
-    def step(self, observation: Observation) -> Command:
-        self.heard += len(observation.inbox)
-        line = observation.line_m
-        turn = (TURN_GAIN_RAD_S if self.height_m - line[0] > LINE_THRESHOLD_M else 0.0) - (
-            TURN_GAIN_RAD_S if self.height_m - line[2] > LINE_THRESHOLD_M else 0.0)
-        return Command(self.rule.update(observation.bearings), turn, None, HEARTBEAT)
 
 
 def bench_loop(sim: Simulation) -> Loop:

@@ -1,0 +1,32 @@
+"""The benchmark's robot: a line follower with seed 003's speed rule and a radio
+heartbeat, the per-tick work of a team that senses, decides and talks every tick
+(:mod:`mjswarm.experiments.bench`)."""
+
+from __future__ import annotations
+
+from algorithms.collision import CollisionRule
+from algorithms.navigation.percept import LINE_THRESHOLD_M
+from algorithms.robot import Command, Controller, Message, Observation
+
+#: the line follower's turn rate when one side sensor sees the strip (rad/s)
+TURN_GAIN_RAD_S = 0.8
+#: what every robot broadcasts every tick (a heartbeat carries nothing but its sender)
+HEARTBEAT = (Message("heartbeat"),)
+
+
+class BenchRobot(Controller):
+    """The bench's controller: hears its inbox and broadcasts a heartbeat every tick,
+    sets its speed with the seed-003 speed rule from its bearings and steers towards the
+    darker side with a proportional line follower on its own line sensors."""
+
+    def __init__(self, rule: CollisionRule, line_sensor_height_m: float) -> None:
+        self.rule = rule
+        self.height_m = line_sensor_height_m
+        self.heard = 0
+
+    def step(self, observation: Observation) -> Command:
+        self.heard += len(observation.inbox)
+        line = observation.line_m
+        turn = (TURN_GAIN_RAD_S if self.height_m - line[0] > LINE_THRESHOLD_M else 0.0) - (
+            TURN_GAIN_RAD_S if self.height_m - line[2] > LINE_THRESHOLD_M else 0.0)
+        return Command(self.rule.update(observation.bearings), turn, None, HEARTBEAT)

@@ -1,0 +1,63 @@
+"""Dump the graph worlds' results on a large grid, to check that a change to the graph
+worlds or the loop leaves them identical (issue 28).
+
+    python benchmarks/graph_results_dump.py OUT.jsonl      # about a minute on 2 cores
+    python benchmarks/graph_results_dump.py NEW.jsonl && cmp OLD.jsonl NEW.jsonl
+
+Every line is one run's full result (JSON, keys sorted): the graph world for every
+shipped strategy on paper arenas, lattices, random trees, graphs and planar graphs, with
+1 to 8 robots, canonical tie rules and three seeds, unit and length edge times; and the
+radio graph world under each connectivity constraint at two ranges.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import sys
+
+from algorithms.exploration import STRATEGIES
+from mjswarm.arena import load_arena
+from mjswarm.worlds.graphworld import GraphWorld, make_minds
+from mjswarm.worlds.radiograph import RadioGraphWorld
+
+ARENAS = ("fig9", "arena1", "arena2", "tree1", "tree2", "tree3", "tree4", "lattice:4x4",
+          "lattice:3x5", "random-tree:14:1", "random-tree:20:2", "random-graph:12:18:3",
+          "random-planar:12:4", "hex:2x2", "wheel:6")
+ROBOTS = (1, 2, 3, 4, 6, 8)
+SEEDS = (None, 0, 1, 2)
+RADIO = (("lattice:4x4", 1.3), ("arena2", 1.0), ("random-graph:12:18:3", 1.5),
+         ("tree2", 1.2))
+
+
+def graph_runs():
+    for arena in ARENAS:
+        spec = load_arena(arena)
+        for edge_time in ("unit", "length"):
+            world = GraphWorld(spec.graph(), spec.root, edge_time=edge_time)
+            for strategy, k, seed in itertools.product(STRATEGIES, ROBOTS, SEEDS):
+                result = world.explore(k, strategy, seed=seed, arena=arena)
+                yield {"world": "graph", **result.to_dict()}
+
+
+def radio_runs():
+    for (arena, range_m), connectivity in itertools.product(RADIO, ("none", "connected",
+                                                                      "biconnected")):
+        spec = load_arena(arena)
+        world = GraphWorld(spec.graph(), spec.root)
+        for k, seed in itertools.product((2, 3, 5), (None, 0, 1)):
+            radio = RadioGraphWorld(world, range_m, connectivity)
+            result = radio.run(make_minds("incidence-dfs", k, seed), seed=seed, arena=arena)
+            yield {"world": "radio-graph", "range": range_m, **result.to_dict()}
+
+
+def main(path: str) -> None:
+    with open(path, "w", encoding="utf-8") as out:
+        for run in itertools.chain(graph_runs(), radio_runs()):
+            out.write(json.dumps(run, sort_keys=True) + "\n")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    main(sys.argv[1])
