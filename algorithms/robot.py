@@ -15,7 +15,9 @@ robot could have in that tick:
   e-puck), keyed by the id the sensor reports;
 * the radio messages it received and its current radio neighbours (link-layer
   knowledge, seed 004's MANET layer);
-* the beacon handle of the vertex whose centre it stands on, else None.
+* the beacon handle of the vertex whose centre it stands on, else None;
+* in the graph worlds, where robots have no bodies, what a scan of that vertex would
+  measure (:class:`VertexSense`).
 
 It never holds another robot's pose, the arena graph or the contact list:
 ``tests/test_robot_type.py`` pins the field list. One :class:`Message` type carries
@@ -48,6 +50,16 @@ class Detection(NamedTuple):
     signal: Hashable | None = None
 
 
+class VertexSense(NamedTuple):
+    """What a robot of a graph world senses of the vertex it stands on (a perfect scan):
+    the incidence angles of its edges (rad, counter-clockwise from the common +x, in
+    (0, 2*pi], seed 003 section 2) and the angle, here, of the edge it arrived by (None:
+    it has not moved since its last call, as at the start or after idling)."""
+
+    angles_rad: tuple[float, ...]
+    arrived_by_rad: float | None
+
+
 #: An empty, read-only mapping (the default of the observation's mappings).
 NOTHING: Mapping = MappingProxyType({})
 
@@ -70,6 +82,7 @@ class Observation(NamedTuple):
         inbox: messages received this tick, in delivery order.
         neighbors: ids the radio hears this tick.
         beacon: the beacon of the vertex whose centre the robot stands on, else None.
+        vertex: in a graph world, at a vertex call, what it senses of the vertex.
     """
 
     robot: Hashable
@@ -85,6 +98,7 @@ class Observation(NamedTuple):
     inbox: Sequence[Message] = ()
     neighbors: frozenset = frozenset()
     beacon: Any = None
+    vertex: VertexSense | None = None
 
 
 class Command(NamedTuple):
@@ -98,6 +112,11 @@ class Command(NamedTuple):
         messages: what it transmits (one-hop broadcasts, or addressed ones).
         signal: what it shows to other robots' range-and-bearing sensors from now on
             (None: keep showing the previous signal).
+        edge_rad: in a graph world, leave the vertex along the edge at this incidence
+            angle (rad); None: stay (the world calls again one time unit later).
+        events: what the robot reports this tick, for the experimenter only (its log, as
+            a real robot's is read after a run): immutable values of types the
+            controller defines, never delivered to another robot.
     """
 
     v_m_s: float = 0.0
@@ -105,6 +124,8 @@ class Command(NamedTuple):
     velocity_m_s: tuple[float, float] | None = None
     messages: tuple[Message, ...] = ()
     signal: Hashable | None = None
+    edge_rad: float | None = None
+    events: tuple = ()
 
 
 #: The command of a robot that stands still and says nothing.
@@ -113,10 +134,15 @@ STOP = Command()
 
 class Controller(ABC):
     """One robot's mind: :meth:`reset` when it is put into a world, then :meth:`step`
-    once per control tick."""
+    once per control tick (after every robot of the tick has :meth:`perceive`-d)."""
 
     def reset(self) -> None:  # noqa: B027 - a hook: most controllers keep no episode state
         """Called when the robot is (re)placed in a world, before its first step."""
+
+    def perceive(self, observation: Observation) -> None:  # noqa: B027 - a hook
+        """Called for every robot of a tick before any of them steps: bookkeeping that
+        must reach what robots share (the beacon they stand on) before any robot of the
+        tick decides (Brass et al.'s model of simultaneous arrivals for MR-DFS)."""
 
     @abstractmethod
     def step(self, observation: Observation) -> Command:

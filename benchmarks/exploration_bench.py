@@ -25,7 +25,7 @@ import mujoco  # noqa: E402
 
 from mjswarm.arena import load_arena  # noqa: E402
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration  # noqa: E402
-from mjswarm.worlds.graphworld import make_minds  # noqa: E402
+from mjswarm.experiments.minds import make_minds  # noqa: E402
 
 
 def bench(arena: str = "arena2", robots: int = 4, speed_m_s: float = 0.05) -> dict:

@@ -18,15 +18,17 @@ import sys
 
 from algorithms.exploration import STRATEGIES
 from mjswarm.arena import load_arena
-from mjswarm.worlds.graphworld import GraphWorld, make_minds
-from mjswarm.worlds.radiograph import RadioGraphWorld
+from mjswarm.experiments.graph_exploration import explore_world
+from mjswarm.experiments.minds import make_minds
+from mjswarm.worlds.graphworld import GraphWorld
+from mjswarm.experiments.radio_exploration import RadioGraphWorld
 
 ARENAS = ("fig9", "arena1", "arena2", "tree1", "tree2", "tree3", "tree4", "lattice:4x4",
-          "lattice:3x5", "random-tree:14:1", "random-tree:20:2", "random-graph:12:18:3",
+          "lattice:3x5", "random-tree:14:1", "random-tree:20:2", "random-graph:12:16:3",
           "random-planar:12:4", "hex:2x2", "wheel:6")
 ROBOTS = (1, 2, 3, 4, 6, 8)
 SEEDS = (None, 0, 1, 2)
-RADIO = (("lattice:4x4", 1.3), ("arena2", 1.0), ("random-graph:12:18:3", 1.5),
+RADIO = (("lattice:4x4", 1.3), ("arena2", 1.0), ("random-graph:12:16:3", 1.5),
          ("tree2", 1.2))
 
 
@@ -36,7 +38,7 @@ def graph_runs():
         for edge_time in ("unit", "length"):
             world = GraphWorld(spec.graph(), spec.root, edge_time=edge_time)
             for strategy, k, seed in itertools.product(STRATEGIES, ROBOTS, SEEDS):
-                result = world.explore(k, strategy, seed=seed, arena=arena)
+                result = explore_world(world, k, strategy, seed=seed, arena=arena)
                 yield {"world": "graph", **result.to_dict()}
 
 

@@ -20,6 +20,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from mjswarm.arena import load_arena
+from mjswarm.experiments.graph_exploration import explore_world
 from mjswarm.worlds.graphworld import GraphWorld
 
 
@@ -33,14 +34,14 @@ def bench(
     """Time ``repeats`` batches of ``runs`` explorations; runs per second (wall clock)."""
     spec = load_arena(arena)
     world = GraphWorld(spec.graph(), spec.root)
-    result = world.explore(robots, strategy)  # warm-up, and a sanity check
+    result = explore_world(world, robots, strategy)  # warm-up, and a sanity check
     if not (result.completed and result.map_correct):
         raise RuntimeError(f"{strategy} did not complete {arena} correctly")
     rates = []
     for _ in range(repeats):
         start = time.perf_counter()
         for _ in range(runs):
-            world.explore(robots, strategy)
+            explore_world(world, robots, strategy)
         rates.append(runs / (time.perf_counter() - start))
     return {
         "arena": spec.name,

@@ -10,6 +10,7 @@ K = 2..8 robots in the graph world, the runs where it is above, and by how many 
 import argparse
 
 from mjswarm.arena import load_arena
+from mjswarm.experiments.graph_exploration import explore_world
 from mjswarm.worlds.graphworld import GraphWorld
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -21,8 +22,8 @@ for seed in range(args.trees):
     spec = load_arena(f"random-tree:{5 + seed % 26}:{seed}")
     world = GraphWorld(spec.graph(), spec.root)
     for k in range(2, 9):
-        ours = world.explore(k, "incidence-dfs").makespan
-        theirs = world.explore(k, "mr-dfs").makespan
+        ours = explore_world(world, k, "incidence-dfs").makespan
+        theirs = explore_world(world, k, "mr-dfs").makespan
         total += 1
         if ours > theirs:
             worse += 1

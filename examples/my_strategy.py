@@ -6,7 +6,9 @@ untaken edge, turns straight back when an untaken edge led to a vertex it alread
 and retreats along the edge it first came by when nothing is left; back at the root with
 nothing left, the search is complete. Its only inputs are the beacon it stands on and the
 incidence angles it measured, so the same class runs in the synchronous graph world and
-on an embodied MuJoCo robot.
+on an embodied MuJoCo robot, through one entry point
+(:func:`mjswarm.experiments.runs.run_exploration`): in each world it runs inside that
+world's controller.
 
     python examples/my_strategy.py                 # fig9, graph world then embodied
     python examples/my_strategy.py --arena arena1
@@ -16,8 +18,8 @@ import argparse
 
 from algorithms.exploration.base import DONE, Strategy, go, match_angle
 from mjswarm.arena import load_arena
-from mjswarm.experiments.exploration import EmbodiedConfig, explore_embodied
-from mjswarm.worlds.graphworld import explore
+from mjswarm.experiments.exploration import EmbodiedConfig
+from mjswarm.experiments.runs import run_exploration
 
 
 class BeaconDfs(Strategy):
@@ -65,10 +67,10 @@ parser.add_argument("--arena", default="fig9")
 args = parser.parse_args()
 
 spec = load_arena(args.arena)
-graph = explore(spec.graph(), spec.root, 1, BeaconDfs)
-print(f"graph world: completed={graph.completed}, map correct={graph.map_correct}, "
-      f"{graph.total_traversals} traversals for {len(spec.edges)} edges")
-body = explore_embodied(spec, 1, BeaconDfs, EmbodiedConfig(speed_m_s=0.15), seed=0)
-print(f"embodied:    completed={body.completed}, map correct={body.map_correct}, "
-      f"{body.total_traversals} traversals in {body.sim_time_s:.0f} s simulated, "
-      f"{body.collisions} contacts")
+for world in ("graph", "embodied"):  # one entry point, any world
+    r = run_exploration(spec, 1, BeaconDfs, world=world, seed=0,
+                        config=EmbodiedConfig(speed_m_s=0.15))
+    where = f"in {r.sim_time_s:.0f} s simulated, {r.collisions} contacts" \
+        if world == "embodied" else f"in {r.makespan:g} time units"
+    print(f"{world + ' world:':<16}completed={r.completed}, map correct={r.map_correct}, "
+          f"{r.total_traversals} traversals for {len(spec.edges)} edges {where}")

@@ -7,6 +7,8 @@ import math
 import networkx as nx
 import numpy as np
 
+from mjswarm.worlds.loop import LoopFunctions
+
 #: Seed 003 Fig. 9 (DESIGN notes): coordinates that reproduce every angle of I10(v6).
 FIG9_POS = {
     "v1": (0, 1), "v2": (1, 1), "v5": (2, 1), "v7": (3, 1), "v3": (0, 0),
@@ -75,3 +77,19 @@ def planar_graph(seed: int) -> tuple[nx.Graph, str]:
         (f"{a[0]}_{a[1]}", f"{b[0]}_{b[1]}") for a, b in edges
     ])
     return h, sorted(h)[int(rng.integers(h.number_of_nodes()))]
+
+
+class Probe(LoopFunctions):
+    """A test's look at a graph-world run: ``observer(time, robot, vertex, mind)`` after
+    each robot's vertex call, in the order the world handled them (tests may read a
+    controller's mind; loop functions of the library may not)."""
+
+    def __init__(self, observer) -> None:
+        self.observer = observer
+
+    def before_step(self, loop) -> None:
+        self._now, self._at = loop.world.time_s, list(loop.world.at)
+
+    def after_step(self, loop) -> None:
+        for i in loop.stepped:
+            self.observer(self._now, i, self._at[i], loop.controllers[i].strategy)

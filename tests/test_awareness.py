@@ -9,7 +9,7 @@ from mjswarm.arena import load_arena
 from mjswarm.experiments.awareness import truth
 from mjswarm.cli import main
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
-from mjswarm.worlds.graphworld import make_minds
+from mjswarm.experiments.minds import make_minds
 
 
 def test_tables_follow_the_moving_radio_graph():

@@ -16,8 +16,9 @@ from algorithms.robot import Message
 from mjswarm.arena import load_arena
 from mjswarm.cli import main
 from mjswarm.errors import MjswarmError
-from mjswarm.worlds.graphworld import GraphWorld, make_minds
-from mjswarm.worlds.radiograph import TICKS_PER_UNIT, RadioGraphWorld
+from mjswarm.experiments.minds import make_minds
+from mjswarm.worlds.graphworld import GraphWorld
+from mjswarm.experiments.radio_exploration import TICKS_PER_UNIT, RadioGraphWorld
 
 
 def run(arena: str, robots: int, range_m: float, connectivity: str = "connected",

@@ -34,8 +34,8 @@ def test_a_user_controller_runs_on_points_and_mujoco_and_is_recorded(tmp_path):
 
 def test_a_user_strategy_explores_both_worlds(tmp_path):
     out = run("my_strategy.py", "--arena", "fig9", cwd=tmp_path)
-    assert "graph world: completed=True, map correct=True" in out
-    assert "embodied:    completed=True, map correct=True" in out and "0 contacts" in out
+    assert "graph world:    completed=True, map correct=True" in out
+    assert "embodied world: completed=True, map correct=True" in out and "0 contacts" in out
 
 
 @pytest.mark.parametrize("suffix", [".png", ".svg"])

@@ -5,11 +5,12 @@ from __future__ import annotations
 import math
 
 import pytest
-from exploration_graphs import fig9
+from exploration_graphs import Probe, fig9
 
 from algorithms.exploration import IncidenceDFS
 from algorithms.exploration.incidence_matrix import COMPLETED, OUT, UNEXPLORED
-from mjswarm.worlds.graphworld import GraphWorld, explore
+from mjswarm.experiments.graph_exploration import explore
+from mjswarm.worlds.graphworld import GraphWorld
 
 PI = math.pi
 
@@ -43,11 +44,11 @@ def run():
     snapshots = {}
     tags = {}
 
-    def observer(t, i, vertex, decision, mind):
+    def observer(t, i, vertex, mind):
         tags[mind.here] = vertex
         snapshots[(t, i)] = (vertex, mind.after_first_step)
 
-    result = explore(fig9(), "v1", 2, Snapshot, observer=observer)
+    result = explore(fig9(), "v1", 2, Snapshot, functions=[Probe(observer)])
     return result, snapshots, tags  # snapshots in the order the world handled them
 
 

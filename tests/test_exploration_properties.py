@@ -14,7 +14,8 @@ from exploration_graphs import grid_tree, lattice, planar_graph, star
 from algorithms.exploration import STRATEGIES, IncidenceDFS
 from algorithms.exploration.base import Decision, Strategy
 from mjswarm.arena import load_arena
-from mjswarm.worlds.graphworld import GraphWorld, explore
+from mjswarm.experiments.graph_exploration import explore, explore_world
+from mjswarm.worlds.graphworld import GraphWorld
 
 ROBOTS = range(1, 9)
 
@@ -27,7 +28,7 @@ def sweep(make_graph, seeds):
         world = GraphWorld(g, root)
         for name in STRATEGIES:
             for k in ROBOTS:
-                results[(seed, name, k)] = (g, root, world.explore(k, name))
+                results[(seed, name, k)] = (g, root, explore_world(world, k, name))
     return results
 
 

@@ -6,12 +6,14 @@ from typing import ClassVar
 
 import networkx as nx
 import pytest
-from exploration_graphs import fig9, graph, lattice
+from exploration_graphs import Probe, fig9, graph, lattice
 
 from algorithms.exploration import DONE, IDLE, go
 from algorithms.exploration.base import Strategy
 from mjswarm.errors import MjswarmError
-from mjswarm.worlds.graphworld import GraphWorld, explore, make_minds
+from mjswarm.experiments.graph_exploration import explore, explore_world, run_minds
+from mjswarm.experiments.minds import make_minds
+from mjswarm.worlds.graphworld import GraphWorld
 
 
 class Script(Strategy):
@@ -44,7 +46,8 @@ def test_edge_time_unit_or_proportional_to_length(edge_time, expected):
     assert r.paths == [["a", "b", "c"]] and r.makespan == expected
     assert r.declared_at == "c" and r.map_correct
     times = []
-    explore(path_graph(), "a", 1, edge_time=edge_time, observer=lambda t, *_: times.append(t))
+    explore(path_graph(), "a", 1, edge_time=edge_time,
+            functions=[Probe(lambda t, *_: times.append(t))])
     assert times == ([0, 1, 2] if edge_time == "unit" else [0, 0.5, 2.0])
 
 
@@ -80,7 +83,7 @@ def test_traversals_under_way_at_the_declaration_do_not_count():
     world = GraphWorld(path_graph(), "b", edge_time="length")
     minds = [Script(0, 2, None, [world.angle_of[("b", "a")], "done"]),
              Script(1, 2, None, [world.angle_of[("b", "c")], "done"])]
-    r = world.run(minds)
+    r = run_minds(world, minds)
     assert (r.completed, r.makespan, r.declared_by, r.declared_at) == (True, 0.5, 1, "a")
     assert r.traversals_per_robot == [1, 0] and r.paths == [["b", "a"], ["b"]]
 
@@ -125,5 +128,29 @@ def test_lattice_ten_by_ten_all_strategies_complete():
     g = lattice(10, 10)
     world = GraphWorld(g, "v0_0")
     for name in ("incidence-dfs", "mr-dfs", "bfs", "lrv", "flooding"):
-        r = world.explore(10, name)
+        r = explore_world(world, 10, name)
         assert r.completed and r.map_correct, name
+
+
+def test_a_users_controller_runs_in_the_graph_world():
+    """Issue 28: any controller written against Observation and Command runs in the graph
+    world (here: always the smallest incidence angle, declaring after five calls)."""
+    from algorithms.exploration.events import Declared
+    from algorithms.robot import Command, Controller
+    from mjswarm.experiments.graph_exploration import run_controllers
+
+    class Smallest(Controller):
+        def __init__(self) -> None:
+            self.calls = 0
+
+        def step(self, observation):
+            self.calls += 1
+            if self.calls == 5:
+                return Command(events=(Declared(()),))
+            return Command(edge_rad=min(observation.vertex.angles_rad))
+
+    world = GraphWorld(fig9(), "v1")
+    result = run_controllers(world, [Smallest(), Smallest()], "smallest")
+    assert result.completed and result.makespan == 4 and result.declared_by == 2
+    assert result.paths[0] == result.paths[1] and len(result.paths[0]) == 5
+    assert not result.map_correct  # an empty map

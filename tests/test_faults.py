@@ -10,7 +10,7 @@ from mjswarm.arena import load_arena
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration, explore_embodied
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.faults import BeaconWipe, RadioBlackout, RobotFailure, parse_fault
-from mjswarm.worlds.graphworld import make_minds
+from mjswarm.experiments.minds import make_minds
 from mjswarm.core.radio import Radio
 
 

@@ -19,7 +19,7 @@ from mjswarm.core.simulation import Simulation
 from mjswarm.core.world import COLLISION_GROUP, Pose2D, WallSegment, world_spec
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
-from mjswarm.worlds.graphworld import make_minds
+from mjswarm.experiments.minds import make_minds
 from mjswarm.worlds.loop import LoopFunctions
 
 #: how far apart (m) the two tiers' paths of one robot may lie (Hausdorff distance);

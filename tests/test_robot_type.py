@@ -22,12 +22,13 @@ from mjswarm.worlds.sparkworld import SparkWorld
 #: added here must be something a real robot could have (algorithms/robot.py).
 ALLOWED_FIELDS = ("robot", "time_s", "line_m", "ir_m", "encoder_rad", "wheel_speed_rad_s",
                   "battery_v", "pose", "bearings", "detections", "inbox", "neighbors",
-                  "beacon")
+                  "beacon", "vertex")
 
 
 def test_an_observation_holds_only_what_a_robot_could_sense():
     assert Observation._fields == ALLOWED_FIELDS
-    assert Command._fields == ("v_m_s", "omega_rad_s", "velocity_m_s", "messages", "signal")
+    assert Command._fields == ("v_m_s", "omega_rad_s", "velocity_m_s", "messages", "signal",
+                               "edge_rad", "events")
 
 
 class Recorder(Controller):

@@ -13,7 +13,7 @@ from algorithms.exploration.entry import (EntryGranted, EntryRequest, LeftVertex
 from mjswarm.arena import incidence_angle, load_arena
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
 from mjswarm.experiments.stations import VertexStations
-from mjswarm.worlds.graphworld import make_minds
+from mjswarm.experiments.minds import make_minds
 
 
 @pytest.fixture

@@ -9,6 +9,7 @@ import pytest
 from mjswarm.arena import load_arena
 from mjswarm.cli import main
 from mjswarm.errors import MjswarmError
+from mjswarm.experiments.graph_exploration import explore_world
 from mjswarm.worlds.graphworld import GraphWorld
 from mjswarm.experiments.sweep import CELL_KEYS, Cell, ResultsFile, grid, run_cell, sweep
 
@@ -28,7 +29,8 @@ def test_local_sweep_writes_every_cell_and_resumes(tmp_path, capsys):
     # each record is the graph world's own result for that cell
     row = next(r for r in rows if r["arena"] == "fig9" and r["robots"] == 2
                and r["strategy"] == "incidence-dfs" and r["seed"] == 0)
-    direct = GraphWorld(load_arena("fig9").graph(), "v1").explore(2, "incidence-dfs", seed=0)
+    direct = explore_world(GraphWorld(load_arena("fig9").graph(), "v1"), 2, "incidence-dfs",
+                           seed=0)
     assert row["makespan"] == direct.makespan and row["map_correct"]
     # a second run skips everything, an extended grid runs only the new cells
     assert main([*ARGS, "--out", str(out)]) == 0

@@ -50,7 +50,8 @@ this combination):
    edge at most twice each way, so past that time nobody is on the way to unblock anybody,
    no beacon changes, and no strategy changes its mind.
 
-This module is the robot side: pure Python, no simulator. :mod:`mjswarm.worlds.radiograph`
+This module is the robot side: pure Python, no simulator.
+:mod:`mjswarm.experiments.radio_exploration`
 runs it in a graph world with a radio and checks the tree against ground truth every
 tick.
 """

@@ -17,78 +17,74 @@ from mjswarm.cli.video_options import add_video_options, check_video
 from mjswarm.core.kinematic import PHYSICS
 from mjswarm.core.robot import spark_v_geometry
 from mjswarm.errors import MjswarmError, RunInterrupted
-from mjswarm.worlds.graphworld import EDGE_TIMES, GraphWorld
-from mjswarm.worlds.radiograph import CONNECTIVITY
+from mjswarm.experiments.radio_exploration import CONNECTIVITY
+from mjswarm.worlds.graphworld import EDGE_TIMES
 
 
 def run_graph(args) -> dict:
     """One run in the graph world; the JSON-ready result (see ``ExplorationResult``)."""
-    from mjswarm.arena import load_arena
+    from mjswarm.experiments.runs import run_exploration
 
-    from mjswarm.worlds.graphworld import make_minds
-    from mjswarm.worlds.radiograph import RadioGraphWorld
-
-    spec = load_arena(args.arena)
-    world = GraphWorld(spec.graph(), args.root or spec.root, edge_time=args.edge_time or "unit")
-    if args.radio_range is None:
-        result = world.explore(
-            args.robots, args.strategy, seed=args.seed, max_time=args.max_time, arena=spec.name
-        )
-    else:
-        radio = RadioGraphWorld(world, args.radio_range, args.connectivity or "none")
-        result = radio.run(make_minds(args.strategy, args.robots, args.seed), seed=args.seed,
-                           max_time=args.max_time, arena=spec.name)
+    spec = _spec(args)
+    result = run_exploration(spec, args.robots, args.strategy, world="graph", seed=args.seed,
+                             max_time=args.max_time, edge_time=args.edge_time or "unit",
+                             radio_range_m=args.radio_range, connectivity=args.connectivity)
     return {"world": "graph", **result.to_dict()}
 
 
-def run_embodied(args) -> dict:
-    """One run with MuJoCo robots; the JSON-ready result (see ``EmbodiedResult``).
-
-    Every option is checked, and the world built, before any output file is opened; the
-    recording goes to a temporary file that replaces ``--record`` when the run ends
-    (:func:`mjswarm.cli.output.atomic_output`)."""
+def _spec(args):
+    """The arena, from its root or ``--root``."""
     from mjswarm.arena import ArenaSpec, load_arena
-    from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
-    from mjswarm.experiments.faults import parse_fault
-    from mjswarm.worlds.graphworld import make_minds
-    from mjswarm.outputs.recording import Recorder
-    from mjswarm.outputs.video import Video, area, filming
 
     spec = load_arena(args.arena)
     if args.root and args.root != spec.root:
         spec = ArenaSpec(spec.name, args.root, spec.vertices, spec.edges, spec.description,
                          spec.source)
-    order = launch_order(args.launch_order, args.robots)
+    return spec
+
+
+def run_embodied(args) -> dict:
+    """One run with MuJoCo robots; the JSON-ready result (see ``EmbodiedResult``).
+
+    Every option is checked before any output file is opened; the recording and the
+    video go to temporary files that replace ``--record`` and ``--video`` when the run
+    ends, or vanish if the run is refused (:func:`mjswarm.cli.output.atomic_output`)."""
+    from mjswarm.experiments.exploration import EmbodiedConfig
+    from mjswarm.experiments.faults import parse_fault
+    from mjswarm.experiments.runs import run_exploration
+    from mjswarm.outputs.recording import Recorder
+    from mjswarm.outputs.video import Video, area, filming
+
+    spec = _spec(args)
     defaults = EmbodiedConfig()
     config = EmbodiedConfig(
         speed_m_s=_or(args.speed, defaults.speed_m_s),
         collision_avoidance=not args.no_collision_avoidance,
         launch_interval_s=_or(args.launch_interval, defaults.launch_interval_s),
-        launch_order=order, radio_range_m=args.radio_range,
-        max_sim_time_s=_or(args.max_time, defaults.max_sim_time_s),
+        launch_order=launch_order(args.launch_order, args.robots),
         stall_timeout_s=args.stall_timeout,
         faults=[parse_fault(f) for f in args.fault or ()],
         line_noise_m=_or(args.line_noise, 0.0), ir_noise_m=_or(args.ir_noise, 0.0),
         wheel_slip=_or(args.wheel_slip, 0.0), physics=args.physics or defaults.physics,
-        bearing_noise_deg=_or(args.bearing_noise, defaults.bearing_noise_deg),
-        connectivity=args.connectivity or "none")
-    run = EmbodiedExploration(spec, make_minds(args.strategy, args.robots, args.seed), config,
-                              args.seed, progress=True)
+        bearing_noise_deg=_or(args.bearing_noise, defaults.bearing_noise_deg))
     with ExitStack() as outputs:
+        recorder = video = None
         if args.record:
             temp = outputs.enter_context(atomic_output(args.record, "recording"))
-            run.recorder = outputs.enter_context(Recorder(
+            recorder = outputs.enter_context(Recorder(
                 temp, spec, args.robots, radio=args.radio_range is not None,
                 video=args.video is not None))
-        video = None
         if args.video:
             video = Video(outputs.enter_context(atomic_output(args.video, "video")),
                           area(spec.vertices.values()), check_video(args),
                           title=f"{spec.name}, {args.robots} robots")
-            run.loop.add(video)
-        with filming(video, run.recorder):
+        with filming(video, recorder):
             try:
-                result = run.run(progress=True)
+                result = run_exploration(
+                    spec, args.robots, args.strategy, world="embodied", seed=args.seed,
+                    max_time=args.max_time, radio_range_m=args.radio_range,
+                    connectivity=args.connectivity, config=config, recorder=recorder,
+                    functions=[video] if video is not None else [], progress=True)
             except RunInterrupted as stop:  # the outputs keep their partial contents
                 stop.result = _embodied_dict(stop.result, args)
                 raise

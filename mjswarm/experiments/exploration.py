@@ -97,8 +97,14 @@ from mjswarm.core.contacts import contact_event
 from mjswarm.core.robot import spark_v_geometry
 from mjswarm.errors import MjswarmError, RunInterrupted
 from mjswarm.experiments.faults import Fault, check_fault, is_user_fault
-from mjswarm.worlds.graphworld import ExplorationResult, make_minds, outcome
-from mjswarm.worlds.radiograph import CONNECTIVITY, NEED, infeasible_reason, need_robots
+from mjswarm.experiments.minds import make_minds, strategy_name
+from mjswarm.experiments.radio_exploration import (
+    CONNECTIVITY,
+    NEED,
+    infeasible_reason,
+    need_robots,
+)
+from mjswarm.experiments.results import ExplorationResult, outcome
 from mjswarm.worlds.loop import Loop, LoopFunctions, Scene
 from mjswarm.worlds.navigation import calibration, conventions
 from mjswarm.core.radio import Radio, Uplink, sight_blocker
@@ -798,7 +804,9 @@ class EmbodiedExploration(LoopFunctions):
         makespan = None if self.declared is None else max(len(p) - 1 for p in self.paths)
         radio = self.world.radio
         return EmbodiedResult(
-            **outcome(self.minds, self.declared, makespan, self.paths, self.beacon_vertex,
+            **outcome(strategy_name(self.minds), self.declared,
+                      () if self.declared is None else self.minds[self.declared[1]].map_edges(),
+                      makespan, self.paths, self.beacon_vertex,
                       {tuple(sorted(e)) for e in self.spec.edges}, arena=self.spec.name,
                       root=self.spec.root, edge_time="physics", seed=self.seed),
             collisions=self.sim.collisions.count,

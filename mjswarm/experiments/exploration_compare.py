@@ -24,6 +24,7 @@ from statistics import mean
 from tqdm import tqdm
 
 from mjswarm.arena import load_arena
+from mjswarm.experiments.graph_exploration import explore_world
 from mjswarm.worlds.graphworld import GraphWorld
 
 #: Display names of the strategies.
@@ -89,7 +90,7 @@ def run_comparison(quick: bool = False, seeds: int = 10, progress: bool = True) 
             for strategy in setting.strategies:
                 for k in setting.robots:
                     results = [
-                        world.explore(k, strategy, seed=seed, arena=spec.name)
+                        explore_world(world, k, strategy, seed=seed, arena=spec.name)
                         for seed in (None, *range(seeds))
                     ]
                     bar.update(len(results))

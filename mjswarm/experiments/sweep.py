@@ -1,7 +1,7 @@
 """Parameter sweeps: a grid of exploration runs, in parallel, resumable (issue 8 part 3).
 
 A sweep is the product arenas x robot counts x strategies x seeds x radio ranges x
-connectivity constraints in one world (``graph``, :mod:`mjswarm.worlds.radiograph`, or
+connectivity constraints in one world (``graph``, :mod:`mjswarm.experiments.radio_exploration`, or
 ``embodied``, :mod:`mjswarm.experiments.exploration` at its default speed; a range without
 a constraint gives the embodied robots connectivity tables, as ``mjswarm explore`` does).
 Each cell is one run of :func:`run_cell`; results are appended to one
@@ -24,7 +24,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from mjswarm.errors import MjswarmError
-from mjswarm.worlds.graphworld import MAX_ROBOTS
+from mjswarm.experiments.minds import MAX_ROBOTS
 
 WORLDS = ("graph", "embodied")
 BACKENDS = ("local", "ray")
@@ -57,7 +57,7 @@ def grid(world: str, arenas: Iterable[str], robots: Iterable[int], strategies: I
     constraint, K < 1, a range that is not positive, a constraint without a range)."""
     from algorithms.exploration import STRATEGIES
     from mjswarm.arena import load_arena
-    from mjswarm.worlds.radiograph import CONNECTIVITY, need_robots
+    from mjswarm.experiments.radio_exploration import CONNECTIVITY, need_robots
 
     ranges, connectivities = list(ranges), list(connectivities)
     for c in connectivities:
@@ -92,24 +92,11 @@ def run_cell(cell: Cell) -> dict:
     """Run one cell; the record written to the results file."""
     from mjswarm.arena import load_arena
 
-    spec = load_arena(cell.arena)
-    if cell.world == "graph":
-        from mjswarm.worlds.graphworld import GraphWorld, make_minds
-        from mjswarm.worlds.radiograph import RadioGraphWorld
+    from mjswarm.experiments.runs import run_exploration
 
-        world = GraphWorld(spec.graph(), spec.root)
-        if cell.radio_range_m is None:
-            result = world.explore(cell.robots, cell.strategy, seed=cell.seed, arena=spec.name)
-        else:
-            result = RadioGraphWorld(world, cell.radio_range_m, cell.connectivity).run(
-                make_minds(cell.strategy, cell.robots, cell.seed), seed=cell.seed,
-                arena=spec.name)
-    else:
-        from mjswarm.experiments.exploration import EmbodiedConfig, explore_embodied
-
-        result = explore_embodied(spec, cell.robots, cell.strategy, seed=cell.seed,
-                                  config=EmbodiedConfig(radio_range_m=cell.radio_range_m,
-                                                        connectivity=cell.connectivity))
+    result = run_exploration(load_arena(cell.arena), cell.robots, cell.strategy,
+                             world=cell.world, seed=cell.seed,
+                             radio_range_m=cell.radio_range_m, connectivity=cell.connectivity)
     record = result.to_dict()
     record.pop("paths", None)
     return {**asdict(cell), **{k: v for k, v in record.items() if k not in CELL_KEYS}}

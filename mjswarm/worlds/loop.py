@@ -17,8 +17,10 @@ between phases, never between two robots::
     robots = world.active()                      # robots on the floor, in id order
     for i in robots entering the floor: controllers[i].reset()
     observations = [world.observe(i) for i in robots]              # sense all
+    for i, o in ...: controllers[i].perceive(o)                    # (bookkeeping)
     commands = [controllers[i].step(o) for i, o in ...]            # control all
     for i, c in zip(robots, commands): world.act(i, c)             # act all
+    loop.reports = [(i, event) for i, c in ... for event in c.events]
     world.step()                               # physics, then the radio delivers
     for f in functions: f.after_step(loop)     # loop.stepped: the robots of this tick
     stop = any(f.should_stop(loop) for f in functions)
@@ -225,7 +227,9 @@ class Loop:
 
     ``halted`` holds the robots the loop no longer steps (a robot that failed); loop
     functions add to it with :meth:`halt`. ``stepped`` lists the robots stepped in the
-    last tick, in order. A robot's controller is reset (:meth:`Controller.reset`) when the
+    last tick, in order, and ``reports`` what they reported (``(robot, event)`` pairs
+    from their commands' ``events``, in order): what loop functions learn of a robot's
+    mind, never its attributes. A robot's controller is reset (:meth:`Controller.reset`) when the
     robot enters the floor: before its first step, and again after each time it was
     off the floor.
     """
@@ -238,7 +242,9 @@ class Loop:
         self.ticks = 0
         self.halted: set[int] = set()
         self.stepped: list = []
-        self._on_floor: set = set()  # robots stepped in the last tick: no reset now
+        self.reports: list[tuple[Any, Any]] = []
+        self._perceive = False  # whether a controller has a perceive() of its own
+        self._on_floor: set = set()  # robots reset since they last entered the floor
         self._stop = False
         for f in functions:
             self.add(f)
@@ -272,24 +278,44 @@ class Loop:
         world, controllers = self.world, self.controllers
         for f in self.functions:
             f.before_step(self)
-        robots = [i for i in world.active() if i not in self.halted]
-        if len(self._on_floor) != len(robots) or not self._on_floor.issuperset(robots):
-            for i in robots:
-                if i not in self._on_floor:
-                    controllers[i].reset()
-            self._on_floor = set(robots)
+        robots = world.active()
+        if self.halted:
+            robots = [i for i in robots if i not in self.halted]
+        self._enter(robots)
         observe, act = world.observe, world.act
         observations = [observe(i) for i in robots]
+        if self._perceive:
+            for i, o in zip(robots, observations):
+                controllers[i].perceive(o)
         commands = [controllers[i].step(o) for i, o in zip(robots, observations)]
+        reports = []
         for i, command in zip(robots, commands):
             act(i, command)
-        self.stepped = robots
+            if command.events:
+                reports += [(i, event) for event in command.events]
+        self.stepped, self.reports = robots, reports
         world.step()
         self.ticks += 1
         for f in self.functions:
             f.after_step(self)
-        if any(f.should_stop(self) for f in self.functions):
-            self._stop = True
+        for f in self.functions:
+            if f.should_stop(self):
+                self._stop = True
+                break
+
+    def _enter(self, robots: list) -> None:
+        """Reset the controllers of robots that entered the floor since the last tick
+        (before their first step, and after each time they were off the floor)."""
+        on_floor, present = self._on_floor, self.world.present
+        if len(on_floor) != int(np.count_nonzero(present)):  # someone left the floor
+            self._on_floor = on_floor = {i for i in on_floor if present[i]}
+        if on_floor.issuperset(robots):
+            return
+        for i in robots:
+            if i not in on_floor:
+                self.controllers[i].reset()
+                on_floor.add(i)
+                self._perceive |= type(self.controllers[i]).perceive is not Controller.perceive
 
     def run(self, max_ticks: int | None = None,
             on_tick: Callable[[Loop], None] | None = None) -> list[Any]:

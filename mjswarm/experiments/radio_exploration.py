@@ -1,5 +1,11 @@
 """The graph world with a radio: seed 003 exploration under a connectivity constraint.
 
+Not yet on the one loop (:mod:`mjswarm.worlds.loop`): :meth:`RadioGraphWorld.run` is
+still world, loop and loop functions in one method, because its tick has a phase the
+loop does not have (robots answer what they hear after everyone has moved, and those
+answers are delivered at the next tick's start); it lives with the experiments until it
+is split.
+
 Time runs in ticks of ``1 / TICKS_PER_UNIT`` time units. A robot crosses an edge in its
 duration (one time unit, or proportional to its length: ``edge_time`` as in
 :class:`~mjswarm.worlds.graphworld.GraphWorld`) at constant speed along the straight
@@ -47,7 +53,9 @@ from algorithms.exploration.relay import ConnectedExplorer, Flooder
 from algorithms.exploration.tether import BASE, BaseStation, Tether, docked, initial_parents
 from mjswarm.core.radio import Radio
 from mjswarm.errors import MjswarmError
-from mjswarm.worlds.graphworld import ExplorationResult, GraphWorld, outcome
+from mjswarm.experiments.minds import strategy_name
+from mjswarm.experiments.results import ExplorationResult, outcome
+from mjswarm.worlds.graphworld import GraphWorld
 
 CONNECTIVITY = ("none", "connected", "biconnected")
 #: Parents each robot keeps under each constraint (rule 1 of the tether).
@@ -76,7 +84,7 @@ def need_robots(connectivity: str, robots: int) -> None:
 class ConnectedExplorationResult(ExplorationResult):
     """An exploration under a connectivity constraint (times in time units).
 
-    Attributes (beyond :class:`~mjswarm.worlds.graphworld.ExplorationResult`'s):
+    Attributes (beyond :class:`~mjswarm.experiments.results.ExplorationResult`'s):
         connectivity: the constraint.
         radio_range_m: the radio range (m).
         messages: radio transmissions, base included.
@@ -217,7 +225,9 @@ class RadioGraphWorld:
             cut += not nx.is_connected(graph)
             fragile += not nx.is_biconnected(graph)
         completed_at = None if declared is None else declared[0]
-        fields = outcome(minds, declared, completed_at, paths, beacon_vertex, w.edges,
+        fields = outcome(strategy_name(minds), declared,
+                         () if declared is None else minds[declared[1]].map_edges(),
+                         completed_at, paths, beacon_vertex, w.edges,
                          arena=arena, root=w.root, edge_time=w.edge_time, seed=seed)
         reason = None if infeasible is None else infeasible_reason(k, self.range_m, paths,
                                                                    len(w.edges))
