@@ -10,7 +10,13 @@ import pytest
 from algorithms.collision import CollisionRule
 from algorithms.navigation.motions import Scan
 from algorithms.navigation.odometry import Odometry, RobotCalibration
-from algorithms.navigation.percept import LINE_THRESHOLD_M, LineFilter, percept
+from algorithms.navigation.percept import (
+    LINE_THRESHOLD_M,
+    WALL_SPREAD_M,
+    LineFilter,
+    WallWatch,
+    percept,
+)
 
 FLOOR_M = 0.020  # the calibration's bare-floor reading
 SUNK_M = 0.0195  # what the dynamic tier reads over the floor: the body sinks 0.46 mm
@@ -113,3 +119,32 @@ def test_bearing_noise_neither_triggers_nor_suppresses_the_rule():
     assert speeds[-1] == pytest.approx(0.08) and rule.activations == 1
     short = CollisionRule(0.1, 0.2, max_window=20)  # too short to tell: suppressed
     assert [short.update(b) for b in course] == [0.1] * 120
+
+
+WALL_M, TOLERANCE_M = 0.024, 0.012  # the corridor wall from the lane, the navigator's tolerance
+
+
+def test_a_noisy_wall_near_the_tolerance_does_not_end_and_its_end_is_seen():
+    """IR noise 2 mm on a wall read at the far edge of its spread in motion (0.031 m,
+    5 mm inside the tolerance): one reading against the tolerance misses it several
+    times (a vertex detected mid-wall), the debounced watch never; the wall's real end
+    (nothing in range) is seen within ``confirm_ticks`` readings."""
+    rng = np.random.default_rng(3)
+    watch = WallWatch(WALL_M, TOLERANCE_M)
+    readings = WALL_M + WALL_SPREAD_M + rng.normal(0.0, 0.002, 3000)
+    seen = [watch(d) for d in readings]
+    assert sum(abs(d - WALL_M) > TOLERANCE_M for d in readings) > 5  # teeth
+    assert all(seen)
+    assert 2 <= watch.confirm_ticks <= 4
+    gone = [watch(math.nan) for _ in range(watch.confirm_ticks)]
+    assert gone == [True] * (watch.confirm_ticks - 1) + [False]
+
+
+def test_noise_free_wall_readings_are_judged_one_by_one():
+    """Without noise (readings drifting by a fraction of a millimetre a tick, as in
+    motion) one reading off the wall ends it: noise-free runs keep their results."""
+    watch = WallWatch(WALL_M, TOLERANCE_M)
+    for d in np.linspace(0.020, 0.030, 40):
+        assert watch(d)
+    assert watch.confirm_ticks == 1
+    assert not watch(math.nan)
