@@ -69,9 +69,10 @@ def test_noise_free_readings_pass_unfiltered():
     assert flt([FLOOR_M - STRIP_M, FLOOR_M, FLOOR_M]) == ((True, False, False), 0)
 
 
-def scan_spokes(spokes_deg, sigma, seed, min_width):
+def scan_spokes(spokes_deg, sigma, seed, min_width, over_read=0.0):
     """A robot scanning in place at 1 rad/s, 50 Hz, over spokes 35 degrees wide (a 30 mm
-    strip at the sensor's 50 mm); returns the Scan when done."""
+    strip at the sensor's 50 mm), its odometry reading ``1 + over_read`` times the turn;
+    returns the Scan when done."""
     rng = np.random.default_rng(seed)
     odo = Odometry(RobotCalibration(0.025, 0.12, 0.05, 0.2))
     flt = LineFilter(FLOOR_M)
@@ -79,7 +80,8 @@ def scan_spokes(spokes_deg, sigma, seed, min_width):
     half = math.degrees(math.asin(0.3))
     theta = 0.0
     for _ in range(2000):
-        on = any(abs(math.remainder(math.degrees(theta) - s, 360.0)) < half for s in spokes_deg)
+        true = math.degrees(theta) / (1.0 + over_read)
+        on = any(abs(math.remainder(true - s, 360.0)) < half for s in spokes_deg)
         d = SUNK_M - (STRIP_M if on else 0.0)
         odo.theta = theta
         odo.update((0.0, 0.0))
@@ -98,6 +100,18 @@ def test_scan_finds_each_spoke_once_at_its_centre_under_noise(seed):
     assert scan.full_turn == pytest.approx(2 * math.pi, abs=math.radians(2))
     found = sorted(math.degrees(m) % 360 for m in scan.mids)
     assert found == pytest.approx(spokes, abs=2.0)
+
+
+@pytest.mark.parametrize("over_read", [0.0, 0.07, 0.09])
+def test_an_uncalibrated_scan_that_over_reads_its_turn_still_closes_it(over_read):
+    """Issue 27's "all noises" run: a first scan read 384 degrees for one turn (scrub and
+    slip 0.05), past the symmetric 22.5 degrees then allowed, scanned 2.5 turns
+    uncalibrated and set off 45 degrees wrong. Odometry never under-reads a turn: the
+    window is skewed to over-reading, and spokes 45 degrees apart stay apart."""
+    spokes = [100.0, 145.0, 260.0]
+    scan = scan_spokes(spokes, 0.0005, 0, math.asin(0.3), over_read)
+    assert scan.full_turn == pytest.approx(2 * math.pi * (1 + over_read), abs=math.radians(2))
+    assert len(scan.mids) == 3
 
 
 def test_bearing_noise_neither_triggers_nor_suppresses_the_rule():
