@@ -10,7 +10,13 @@ import pytest
 from algorithms.collision import CollisionRule
 from algorithms.navigation.motions import Scan
 from algorithms.navigation.odometry import Odometry, RobotCalibration
-from algorithms.navigation.percept import LINE_THRESHOLD_M, LineFilter, percept
+from algorithms.navigation.percept import (
+    LINE_THRESHOLD_M,
+    WALL_SPREAD_M,
+    LineFilter,
+    WallWatch,
+    percept,
+)
 
 FLOOR_M = 0.020  # the calibration's bare-floor reading
 SUNK_M = 0.0195  # what the dynamic tier reads over the floor: the body sinks 0.46 mm
@@ -63,9 +69,10 @@ def test_noise_free_readings_pass_unfiltered():
     assert flt([FLOOR_M - STRIP_M, FLOOR_M, FLOOR_M]) == ((True, False, False), 0)
 
 
-def scan_spokes(spokes_deg, sigma, seed, min_width):
+def scan_spokes(spokes_deg, sigma, seed, min_width, over_read=0.0):
     """A robot scanning in place at 1 rad/s, 50 Hz, over spokes 35 degrees wide (a 30 mm
-    strip at the sensor's 50 mm); returns the Scan when done."""
+    strip at the sensor's 50 mm), its odometry reading ``1 + over_read`` times the turn;
+    returns the Scan when done."""
     rng = np.random.default_rng(seed)
     odo = Odometry(RobotCalibration(0.025, 0.12, 0.05, 0.2))
     flt = LineFilter(FLOOR_M)
@@ -73,7 +80,8 @@ def scan_spokes(spokes_deg, sigma, seed, min_width):
     half = math.degrees(math.asin(0.3))
     theta = 0.0
     for _ in range(2000):
-        on = any(abs(math.remainder(math.degrees(theta) - s, 360.0)) < half for s in spokes_deg)
+        true = math.degrees(theta) / (1.0 + over_read)
+        on = any(abs(math.remainder(true - s, 360.0)) < half for s in spokes_deg)
         d = SUNK_M - (STRIP_M if on else 0.0)
         odo.theta = theta
         odo.update((0.0, 0.0))
@@ -92,6 +100,18 @@ def test_scan_finds_each_spoke_once_at_its_centre_under_noise(seed):
     assert scan.full_turn == pytest.approx(2 * math.pi, abs=math.radians(2))
     found = sorted(math.degrees(m) % 360 for m in scan.mids)
     assert found == pytest.approx(spokes, abs=2.0)
+
+
+@pytest.mark.parametrize("over_read", [0.0, 0.07, 0.09])
+def test_an_uncalibrated_scan_that_over_reads_its_turn_still_closes_it(over_read):
+    """Issue 27's "all noises" run: a first scan read 384 degrees for one turn (scrub and
+    slip 0.05), past the symmetric 22.5 degrees then allowed, scanned 2.5 turns
+    uncalibrated and set off 45 degrees wrong. Odometry never under-reads a turn: the
+    window is skewed to over-reading, and spokes 45 degrees apart stay apart."""
+    spokes = [100.0, 145.0, 260.0]
+    scan = scan_spokes(spokes, 0.0005, 0, math.asin(0.3), over_read)
+    assert scan.full_turn == pytest.approx(2 * math.pi * (1 + over_read), abs=math.radians(2))
+    assert len(scan.mids) == 3
 
 
 def test_bearing_noise_neither_triggers_nor_suppresses_the_rule():
@@ -113,3 +133,32 @@ def test_bearing_noise_neither_triggers_nor_suppresses_the_rule():
     assert speeds[-1] == pytest.approx(0.08) and rule.activations == 1
     short = CollisionRule(0.1, 0.2, max_window=20)  # too short to tell: suppressed
     assert [short.update(b) for b in course] == [0.1] * 120
+
+
+WALL_M, TOLERANCE_M = 0.024, 0.012  # the corridor wall from the lane, the navigator's tolerance
+
+
+def test_a_noisy_wall_near_the_tolerance_does_not_end_and_its_end_is_seen():
+    """IR noise 2 mm on a wall read at the far edge of its spread in motion (0.031 m,
+    5 mm inside the tolerance): one reading against the tolerance misses it several
+    times (a vertex detected mid-wall), the debounced watch never; the wall's real end
+    (nothing in range) is seen within ``confirm_ticks`` readings."""
+    rng = np.random.default_rng(3)
+    watch = WallWatch(WALL_M, TOLERANCE_M)
+    readings = WALL_M + WALL_SPREAD_M + rng.normal(0.0, 0.002, 3000)
+    seen = [watch(d) for d in readings]
+    assert sum(abs(d - WALL_M) > TOLERANCE_M for d in readings) > 5  # teeth
+    assert all(seen)
+    assert 2 <= watch.confirm_ticks <= 4
+    gone = [watch(math.nan) for _ in range(watch.confirm_ticks)]
+    assert gone == [True] * (watch.confirm_ticks - 1) + [False]
+
+
+def test_noise_free_wall_readings_are_judged_one_by_one():
+    """Without noise (readings drifting by a fraction of a millimetre a tick, as in
+    motion) one reading off the wall ends it: noise-free runs keep their results."""
+    watch = WallWatch(WALL_M, TOLERANCE_M)
+    for d in np.linspace(0.020, 0.030, 40):
+        assert watch(d)
+    assert watch.confirm_ticks == 1
+    assert not watch(math.nan)

@@ -8,7 +8,10 @@ import pytest
 
 from mjswarm.experiments.stress import (
     MAX_HEADING_ERROR_DEG,
+    NOISE_ARENAS,
     NOISES,
+    SAMPLE_SPEEDS_M_S,
+    SAMPLE_TEAMS,
     Noise,
     StressRun,
     grid,
@@ -100,6 +103,15 @@ def test_noise_grid_covers_every_noise_alone_and_together_in_both_tiers():
     together = NOISES[-1]
     assert (together.line_m, together.ir_m, together.bearing_deg, together.wheel_slip) == (
         0.0005, 0.002, 2.0, 0.05)
+
+
+def test_the_sample_covers_every_class_noise_and_tier_at_both_ends_of_the_speeds():
+    """``--noise --sample``: every arena class under every noise (alone and together), in
+    both tiers, at 0.05 and 0.2 m/s, once."""
+    runs = noise_grid(speeds=SAMPLE_SPEEDS_M_S, teams=SAMPLE_TEAMS, seeds=(0,))
+    cells = {(r.arena, r.speed_m_s, r.noise, r.physics) for r in runs}
+    assert len(cells) == len(runs) == len(NOISE_ARENAS) * 2 * len(NOISES) * 2
+    assert {r.speed_m_s for r in runs} == {0.05, 0.2}
 
 
 def test_noise_table_counts_the_heading_criterion():

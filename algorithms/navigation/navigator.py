@@ -58,7 +58,7 @@ from algorithms.navigation.motions import (
     wrap,
 )
 from algorithms.navigation.odometry import Odometry, RobotCalibration
-from algorithms.navigation.percept import LineFilter, Percept
+from algorithms.navigation.percept import LineFilter, Percept, WallWatch
 
 SHIFT_ANGLE = math.radians(60.0)
 #: Top speed (m/s) of the approach to a vertex centre (finding and following the spoke,
@@ -130,6 +130,8 @@ class Navigator:
         self.odometry = Odometry(calibration, theta=heading)
         #: its line detection (:func:`~.percept.percept` reads through it)
         self.line_filter = LineFilter(calibration.line_floor_m)
+        #: its vertex detection: the left IR's wall, debounced
+        self.wall_watch = WallWatch(conventions.wall_distance_m, conventions.wall_tolerance_m)
         self.speed = speed_m_s
         self._approach_speed = min(speed_m_s, APPROACH_SPEED_M_S)
         self.turn_rate = turn_rate_rad_s
@@ -304,9 +306,11 @@ class Navigator:
 
         A wall is an IR reading within ``wall_tolerance_m`` of ``wall_distance_m``, the
         distance from the lane to the corridor wall: a robot passing on the left is seen
-        at other, changing distances and is not taken for a wall (NaN never matches)."""
+        at other, changing distances and is not taken for a wall (NaN never matches). It
+        is gone once :class:`~.percept.WallWatch` has missed it for several readings in a
+        row under IR noise (one noisy reading is no vertex)."""
         travelled = self.odometry.distance_m
-        if abs(percept.ir[0] - self.conv.wall_distance_m) <= self.conv.wall_tolerance_m:
+        if self.wall_watch(percept.ir[0]):
             if self._wall_run_start is None:
                 self._wall_run_start = travelled
             if self._wall_first_m is None:

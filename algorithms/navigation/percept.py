@@ -124,6 +124,81 @@ class LineFilter:
         return (self._on[0], self._on[1], self._on[2]), (n - 1) // 2
 
 
+#: How far (m) the left IR's wall readings stray from the nominal wall distance while a
+#: robot follows its lane (the follower's swings and the corridor's ends: 0.018-0.031 m
+#: around 0.024 m measured noise-free at 0.2 m/s, dynamic tier): what is left of the
+#: navigator's wall tolerance beyond it is the margin a noisy reading must cross to miss
+#: the wall.
+WALL_SPREAD_M = 0.007
+#: A wall that is there is missed for ``confirm_ticks`` readings in a row with at most this
+#: probability: 3e-7, the line filter's rate (:data:`LINE_SIGMAS`, a Gaussian 5-sigma tail).
+WALL_MISS_RATE = 3e-7
+#: The longest confirmation (control ticks): also the one used while the noise is unknown.
+WALL_CONFIRM_MAX = 5
+#: Consecutive wall readings the IR noise estimate needs: fewer than a robot takes over
+#: the navigator's ``min_wall_run_m`` (5 cm) at the 0.2 m/s top speed (12 at 50 Hz), so
+#: the estimate is in before the first wall can end (the median of 10 errs by a third).
+WALL_NOISE_MIN_SAMPLES = 10
+
+
+class WallWatch:
+    """Vertex detection by the left IR sensor, debounced: is the corridor wall beside?
+
+    A reading sees the wall when it is within ``tolerance_m`` of ``wall_distance_m`` (NaN,
+    nothing in range, never does). One reading out of tolerance is no vertex under IR
+    noise: readings stray up to ``WALL_SPREAD_M`` from the wall distance in motion, which
+    leaves a margin ``m = tolerance_m - WALL_SPREAD_M`` (5 mm for the 12 mm tolerance); at
+    2 mm of noise one reading misses the wall with probability ``p = Phi(-m / sigma)``
+    (0.6 %), several times per edge at 50 Hz. So the wall counts as gone only after
+    ``confirm_ticks`` misses in a row, the smallest ``k`` with ``p^k <= WALL_MISS_RATE``
+    (1 without noise, so noise-free runs keep their results; 3 at 2 mm), at most
+    ``WALL_CONFIRM_MAX``; a shorter gap does not interrupt the wall. The detection comes
+    ``k - 1`` ticks late (8 mm at 0.2 m/s and 50 Hz for k = 3; walls are at least 8 cm).
+
+    The noise ``sigma`` is the robot's own estimate, as :class:`LineFilter`'s: the median of
+    ``|reading - previous reading|`` over consecutive wall readings, the last
+    ``NOISE_SAMPLES`` (``WALL_CONFIRM_MAX`` while fewer than ``WALL_NOISE_MIN_SAMPLES``).
+    """
+
+    def __init__(self, wall_distance_m: float, tolerance_m: float) -> None:
+        self.wall_distance_m, self.tolerance_m = wall_distance_m, tolerance_m
+        self._diffs: deque[float] = deque(maxlen=NOISE_SAMPLES)
+        self._last_wall: float | None = None  # the previous reading, if it saw the wall
+        self._missed = WALL_CONFIRM_MAX  # readings in a row without the wall
+
+    @property
+    def noise_m(self) -> float | None:
+        """The estimated noise standard deviation (m), None while too few readings."""
+        if len(self._diffs) < WALL_NOISE_MIN_SAMPLES:
+            return None
+        return statistics.median(self._diffs) / _MEDIAN_ABS_DIFF
+
+    @property
+    def confirm_ticks(self) -> int:
+        """How many readings in a row must miss the wall for it to be gone."""
+        sigma = self.noise_m
+        if sigma is None:
+            return WALL_CONFIRM_MAX
+        margin = self.tolerance_m - WALL_SPREAD_M
+        p = 0.5 * math.erfc(margin / sigma / math.sqrt(2.0)) if sigma > 0.0 else 0.0
+        if p <= WALL_MISS_RATE:
+            return 1
+        return min(WALL_CONFIRM_MAX, math.ceil(math.log(WALL_MISS_RATE) / math.log(p)))
+
+    def __call__(self, left_ir_m: float) -> bool:
+        """Take this tick's left IR reading (m, NaN for nothing); return whether the wall
+        is beside the robot (seen now, or missed for fewer than ``confirm_ticks``)."""
+        wall = abs(left_ir_m - self.wall_distance_m) <= self.tolerance_m
+        if wall:
+            if self._last_wall is not None:
+                self._diffs.append(abs(left_ir_m - self._last_wall))
+            self._last_wall, self._missed = left_ir_m, 0
+            return True
+        self._last_wall = None
+        self._missed += 1
+        return self._missed < self.confirm_ticks
+
+
 def percept(line_m: Sequence[float], ir_m: Sequence[float], encoder_rad: Sequence[float],
             line_filter: LineFilter) -> Percept:
     """A robot's raw readings (m, m, rad) as a :class:`Percept`, its line readings

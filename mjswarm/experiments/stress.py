@@ -76,6 +76,10 @@ NOISES = (
 NOISE_ARENAS = ("fan:3:45@17", "wheel:4@8", "hex:2x2@30", "tri:2x3@7", "lattice:4x4@33",
                 "arena2", "random-planar:8:1")
 NOISE_TEAMS = (1, 4)
+#: ``--sample``: the noise grid's declared subset, one seed of every arena class, noise and
+#: tier at the paper's speed and the top speed, teams of 4 (140 runs).
+SAMPLE_SPEEDS_M_S = (0.05, 0.2)
+SAMPLE_TEAMS = (4,)
 #: The noise grid's heading criterion (deg): issue 27's "heading error within 5 degrees".
 MAX_HEADING_ERROR_DEG = 5.0
 
@@ -193,10 +197,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--noise", action="store_true",
                         help="run issue 27's noise grid instead (--arenas defaults to its "
                              "classes; every speed, noise level and physics tier)")
+    parser.add_argument("--sample", action="store_true",
+                        help="with --noise: only 0.05 and 0.2 m/s, teams of 4 and one seed "
+                             "(140 runs)")
     args = parser.parse_args(argv)
+    if args.sample and not args.noise:
+        parser.error("--sample needs --noise")
     if args.noise:
         arenas = NOISE_ARENAS if args.arenas is None else args.arenas.split(",")
-        runs = noise_grid(arenas=arenas, seeds=range(args.seeds or 2))
+        if args.sample:
+            runs = noise_grid(arenas=arenas, speeds=SAMPLE_SPEEDS_M_S, teams=SAMPLE_TEAMS,
+                              seeds=range(args.seeds or 1))
+        else:
+            runs = noise_grid(arenas=arenas, seeds=range(args.seeds or 2))
         heading = MAX_HEADING_ERROR_DEG
     else:
         arenas = ARENAS if args.arenas is None else args.arenas.split(",")
