@@ -50,7 +50,7 @@ from mjswarm.core.robot import (
     measure_geometry,
 )
 from mjswarm.core.sight import LineOfSight
-from mjswarm.core.world import Pose2D, yaw_quat
+from mjswarm.core.world import Pose2D, quiet_empty_prefix, yaw_quat
 
 #: One robot's sensor record: line rangefinders (m), IR distances (m, NaN = nothing
 #: within range), wheel encoders (rad), wheel speeds (rad/s), battery voltage (V).
@@ -118,7 +118,8 @@ class Simulation:
             raise MjswarmError("the kinematic tier senses with the ray caster: use sensing "
                                "'grid' or 'auto' with physics 'kinematic'")
         try:
-            self.model = spec.compile()
+            with quiet_empty_prefix():  # robots attached in groups (world.attach_robots)
+                self.model = spec.compile()
         except ValueError as exc:
             raise MjswarmError(f"world does not compile: {one_line(exc)}") from None
         self.data = mujoco.MjData(self.model)
@@ -158,9 +159,7 @@ class Simulation:
         joints = m.body_jntadr[self.robot_bodies]
         self._qpos_adr = m.jnt_qposadr[joints]
         self._pose_qpos = self._qpos_adr[:, None] + np.arange(7)  # free joints: xyz, quat
-        geom_robot = np.full(m.ngeom, -1, dtype=np.int64)
-        for i, root in enumerate(self.robot_bodies):
-            geom_robot[np.isin(m.geom_bodyid, self._subtree(root))] = i
+        geom_robot = self._body_robot()[m.geom_bodyid]
         self.geom_robot = geom_robot
         if self.n == 0:
             raise MjswarmError("a simulation needs at least one robot")
@@ -204,14 +203,17 @@ class Simulation:
             self._sight = LineOfSight(self)
         return self._sight
 
-    def _subtree(self, root: int) -> np.ndarray:
-        """Body ids of ``root`` and all its descendants."""
+    def _body_robot(self) -> np.ndarray:
+        """The robot whose subtree holds each body, -1 for none (bodies come in
+        depth-first order, so a parent precedes its children): O(nbody)."""
         m = self.model
-        inside = np.zeros(m.nbody, bool)
-        inside[root] = True
-        for b in range(root + 1, m.nbody):
-            inside[b] = inside[m.body_parentid[b]]
-        return np.flatnonzero(inside)
+        owner = np.full(m.nbody, -1, np.int64)
+        owner[self.robot_bodies] = np.arange(self.n)
+        own, parent = owner.tolist(), m.body_parentid.tolist()
+        for b in range(1, m.nbody):
+            if own[b] < 0:
+                own[b] = own[parent[b]]
+        return np.array(own, np.int64)
 
     # ------------------------------------------------------------------ commands
     def set_wheel_speeds(self, omega_rad_s: np.ndarray) -> None:
