@@ -67,3 +67,20 @@ def test_geom_robot_is_each_robots_subtree():
             b = m.body_parentid[b]
         expected = int(np.flatnonzero(sim.robot_bodies == b)[0]) if b in sim.robot_bodies else -1
         assert sim.geom_robot[g] == expected, name
+
+
+@pytest.mark.parametrize("physics, sensing", [("kinematic", "auto"), ("dynamic", "grid")])
+def test_compiling_without_sensors_gives_the_same_model(physics, sensing):
+    """Grid sensing compiles with MuJoCo's sensors off (they would cast every rangefinder
+    against every geom once): the model is the one compiled with them on, and the
+    caller's spec keeps its flags."""
+    import mujoco
+
+    spec = _spec([Pose2D(0.3 * i, 0.2 * (i % 3), 0.5 * i) for i in range(6)])
+    a = Simulation(spec, physics=physics, sensing=sensing).model
+    assert spec.option.disableflags == 0
+    b = spec.compile()
+    b.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+    for k in [k for k in dir(a) if not k.startswith("_") and isinstance(getattr(a, k, None), np.ndarray)]:
+        assert np.array_equal(getattr(a, k), getattr(b, k), equal_nan=True), k
+    assert a.opt.disableflags == b.opt.disableflags

@@ -73,6 +73,11 @@ GRID_SENSING_MIN_ROBOTS = 32
 UNBOUNDED_PROBE_M = 0.1
 
 
+def _robot_count(spec: mujoco.MjSpec) -> int:
+    """Robots in an uncompiled world: bodies named ``.../ROOT_BODY``."""
+    return sum(1 for b in spec.bodies if b.name.endswith(f"/{ROOT_BODY}"))
+
+
 class Simulation:
     """N robots stepping together.
 
@@ -117,11 +122,21 @@ class Simulation:
         if physics == "kinematic" and sensing == "mujoco":
             raise MjswarmError("the kinematic tier senses with the ray caster: use sensing "
                                "'grid' or 'auto' with physics 'kinematic'")
+        sensor_bit = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+        flags = spec.option.disableflags
+        if physics == "kinematic" or sensing == "grid" or (
+                sensing == "auto" and _robot_count(spec) >= GRID_SENSING_MIN_ROBOTS):
+            # compiling evaluates every sensor once (mj_setConst steps through mj_forward):
+            # for grid sensing, N robots' rangefinders against every geom, O(N^2), that
+            # nobody reads (20 s of a 10,000-robot build); the flag is set below anyway
+            spec.option.disableflags = flags | sensor_bit
         try:
             with quiet_empty_prefix():  # robots attached in groups (world.attach_robots)
                 self.model = spec.compile()
         except ValueError as exc:
             raise MjswarmError(f"world does not compile: {one_line(exc)}") from None
+        finally:
+            spec.option.disableflags = flags  # the caller's spec as it was
         self.data = mujoco.MjData(self.model)
         m = self.model
         self.n = sum(1 for b in range(m.nbody) if m.body(b).name.endswith(f"/{ROOT_BODY}"))
