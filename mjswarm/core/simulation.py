@@ -201,6 +201,7 @@ class Simulation:
         self._rays = RayCaster(m, self.data, self.robot_bodies, geom_robot) if sensing == "grid" else None
         self._drive = KinematicDrive(self) if physics == "kinematic" else None
         self._no_torque = np.zeros((self.n, 2))
+        self._wheel_cmd = np.zeros((self.n, 2))  # set_velocity's buffer
         self._sense_now()
 
     @property
@@ -250,13 +251,27 @@ class Simulation:
         wheel limit is scaled down as a whole, keeping the path's curvature ``omega / v``.
         """
         g = self.geometry
-        v = np.broadcast_to(np.asarray(v_m_s, float), (self.n,))
-        w = np.broadcast_to(np.asarray(omega_rad_s, float), (self.n,))
-        wheels = np.stack([v - w * g.track_m / 2.0, v + w * g.track_m / 2.0], axis=1)
+        v = np.asarray(v_m_s, float)
+        w = np.asarray(omega_rad_s, float)
+        if v.shape != (self.n,):
+            v = np.broadcast_to(v, (self.n,))
+        if w.shape != (self.n,):
+            w = np.broadcast_to(w, (self.n,))
+        # into a buffer kept for it, in the operations (and so the roundings) of
+        # wheels = [v - w b / 2, v + w b / 2] / r, scaled down by max / peak where over
+        turn = w * g.track_m
+        turn /= 2.0
+        wheels = self._wheel_cmd
+        np.subtract(v, turn, out=wheels[:, 0])
+        np.add(v, turn, out=wheels[:, 1])
         wheels /= g.wheel_radius_m
-        peak = np.abs(wheels).max(axis=1, keepdims=True)
-        scale = np.where(peak > g.max_wheel_speed_rad_s, g.max_wheel_speed_rad_s / np.maximum(peak, 1e-12), 1.0)
-        self.set_wheel_speeds(wheels * scale)
+        peak = np.abs(wheels).max(axis=1)
+        over = peak > g.max_wheel_speed_rad_s
+        if over.any():
+            wheels[over] *= (g.max_wheel_speed_rad_s / np.maximum(peak[over], 1e-12))[:, None]
+        if not np.isfinite(peak).all():
+            raise MjswarmError("wheel speed commands must be finite")
+        self.data.ctrl[self._actuators] = wheels
 
     def place_robot(self, i: int, pose: Pose2D) -> None:
         """Put robot ``i`` down at ``pose``, at rest (the experimenter's hand, not physics)."""
