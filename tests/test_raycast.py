@@ -205,10 +205,11 @@ def test_bad_sensing_and_unsupported_geoms_are_one_line_errors():
         Simulation(spec, sensing="grid")
     spec = world_spec([Pose2D(0, 0, 0), Pose2D(0.3, 0, np.pi)])
     spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[0.05, 0.1, 0], pos=[1, 1, 0.1])
-    sim = Simulation(spec, sensing="mujoco")  # MuJoCo's rangefinders see capsules
+    sim = Simulation(spec, sensing="mujoco")  # MuJoCo's rangefinders see capsules,
     sim.step()
+    assert [set(seen) for seen in BearingSensor(sim).read()] == [{1}, {0}]  # and its line of sight
     with pytest.raises(MjswarmError, match="CAPSULE"):
-        BearingSensor(sim).read()
+        sim.rays  # the grid caster does not
     with pytest.raises(MjswarmError, match="threads must be"):
         RayCaster(sim.model, sim.data, sim.robot_bodies, sim.geom_robot, threads=0)
     with pytest.raises(MjswarmError, match="cell size"):

@@ -100,7 +100,10 @@ class PosRequest(NamedTuple):
 
 
 class Table(NamedTuple):
-    centres: dict
+    """A robot's table of region centres, as ``(robot, centre)`` pairs in its order
+    (a tuple: one message object reaches every receiver, so it must not change)."""
+
+    centres: tuple
 
 
 class Leave(NamedTuple):
@@ -278,9 +281,9 @@ class BiconnectedRobot(Controller):
                     out.append(Message(p))
             elif isinstance(p, PosRequest):
                 if self.stage is None:
-                    out.append(Message(Table(dict(self.table)), to=m.sender))
+                    out.append(Message(Table(tuple(self.table.items())), to=m.sender))
             elif isinstance(p, Table):
-                self._replies.append((m.sender, p.centres))
+                self._replies.append((m.sender, dict(p.centres)))
             elif isinstance(p, Leave):
                 self._on_leave(p, now, out)
             elif isinstance(p, Move):

@@ -25,7 +25,7 @@ from mjswarm.arena.geometry import (
 from mjswarm.arena.spec import ArenaSpec
 from mjswarm.errors import MjswarmError, one_line
 from mjswarm.core.robot import DEFAULT_ROBOT_XML
-from mjswarm.core.world import FloorStrip, Pose2D, WallSegment, world_spec
+from mjswarm.core.world import FloorStrip, Pose2D, WallSegment, quiet_empty_prefix, world_spec
 
 VERTEX_SITE_PREFIX = "vertex:"
 
@@ -64,11 +64,13 @@ def export_mjcf(spec: ArenaSpec, out: str | Path, robots: int = 0) -> Path:
     root = spec.vertices[spec.root]
     world = arena_world_spec(spec, [Pose2D(root[0], root[1], 0.0)] * robots)
     try:
-        world.compile()
+        with quiet_empty_prefix():
+            world.compile()
     except ValueError as exc:
         raise MjswarmError(f"arena {spec.name} does not compile: {one_line(exc)}") from None
     out = Path(out)
     if not out.parent.is_dir():
         raise MjswarmError(f"output directory does not exist: {out.parent}")
-    out.write_text(world.to_xml())
+    with quiet_empty_prefix():  # robots attached in groups (world.attach_robots)
+        out.write_text(world.to_xml())
     return out

@@ -38,11 +38,22 @@ Choices the papers leave open:
   robot order, so a run is a pure function of the seed.
 * Explicit-edge mode (``edges=...``) replaces the range by a given link set, for the static
   harness and tests; :meth:`Radio.set_edges` changes it.
+* Payloads are immutable values (:func:`check_immutable`): one message object is handed to
+  every robot that hears it, so a list or a dict in it would be shared state between robots.
+  :meth:`Radio.send` and the :class:`Uplink` refuse anything else.
+* Delivery is by arrays: a tick's copies are (message, recipient) index pairs, built from
+  the link table without a Python step per copy; presence, blackouts and drops are masks
+  over them (drop draws ``rng.random(copies)`` in the order above: the same stream, and so
+  the same drops, as one draw per copy); counters add up by ``bincount``; a robot's inbox
+  is cut from the sorted copies when it asks (``tests/test_radio_arrays.py`` checks
+  deliveries and counters against copy-by-copy delivery on random cases).
 """
 
 from __future__ import annotations
 
 import math
+import dataclasses
+import enum
 from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -63,6 +74,71 @@ Blocker = Callable[[np.ndarray], np.ndarray]
 
 #: relative enlargement of the k-d tree's search radius over d_c (the exact test decides)
 _CANDIDATE_SLACK = 1e-9
+
+# ------------------------------------------------------------------ immutable payloads
+_ATOM, _SEQUENCE, _FIELDS, _HANDLE = range(4)
+#: what each type is, found once per type: an immutable atom, an immutable sequence of
+#: values (tuple, NamedTuple, frozenset), a frozen dataclass (its fields), or refused (None)
+_KINDS: dict[type, tuple[int, tuple[str, ...]] | None] = {
+    t: (_ATOM, ()) for t in (type(None), bool, int, float, complex, str, bytes, range,
+                             type(Ellipsis), type(NotImplemented))}
+
+
+def _kind(t: type) -> tuple[int, tuple[str, ...]] | None:
+    found = _KINDS.get(t, False)
+    if found is not False:
+        return found
+    if issubclass(t, (np.generic, enum.Enum)) or t in _HANDLES:
+        found = (_ATOM, ())
+    elif issubclass(t, (tuple, frozenset)):
+        found = (_SEQUENCE, ())
+    elif dataclasses.is_dataclass(t) and t.__dataclass_params__.frozen:
+        found = (_FIELDS, tuple(f.name for f in dataclasses.fields(t)))
+    else:
+        found = None
+    _KINDS[t] = found
+    return found
+
+
+def _handle_types() -> tuple[type, ...]:
+    """Objects that still travel as references while issue 28 moves them to opaque ids:
+    the exploration's :class:`~algorithms.exploration.base.Beacon` (a relay request names
+    the beacons of its route; receivers compare them by identity)."""
+    from algorithms.exploration.base import Beacon
+
+    return (Beacon,)
+
+
+_HANDLES = frozenset(_handle_types())
+
+
+def check_immutable(value: Any, what: str = "radio payload") -> None:
+    """Raise :class:`MjswarmError` unless ``value`` is an immutable value: None, bool, int,
+    float, complex, str, bytes, a numpy scalar, an Enum member, or a tuple (NamedTuple),
+    frozenset or frozen dataclass made of such values, at any depth. A list, dict, set,
+    bytearray, numpy array, non-frozen dataclass or any other object is refused. The kind
+    of each type is found once and kept, so a check costs a dictionary look-up per value.
+    """
+    stack = [value]
+    while stack:
+        v = stack.pop()
+        kind = _KINDS.get(type(v), False)
+        if kind is False:
+            kind = _kind(type(v))
+        if kind is None:
+            raise MjswarmError(
+                f"{what} must be an immutable value (tuple, frozenset, NamedTuple, frozen "
+                f"dataclass, number, str...), not {type(v).__qualname__}: {_short(v)}")
+        if kind[0] == _SEQUENCE:
+            stack.extend(v)
+        elif kind[0] == _FIELDS:
+            stack.extend(getattr(v, name) for name in kind[1])
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
 
 
 class Radio:
@@ -111,17 +187,27 @@ class Radio:
         self.drop_prob = float(drop_prob)
         self._rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
         self._present: dict[Hashable, None] = dict.fromkeys(self.robots)
+        self._on_air = np.ones(len(self.robots), bool)  # _present as a mask, by index
         self._neighbors: dict[Hashable, frozenset] = {r: frozenset() for r in self.robots}
         self._ordered: dict[Hashable, tuple] = {r: () for r in self.robots}
         self._links: np.ndarray | None = None  # the index pairs the two dicts were built from
+        #: the same links as arrays: robot k's neighbours, by index and in robot order,
+        #: are ``table[0][table[1][k]:table[1][k + 1]]`` (replaced, never changed, on relink)
+        self._table: tuple[np.ndarray, np.ndarray] = (np.empty(0, np.intp),
+                                                      np.zeros(len(self.robots) + 1, np.intp))
         self._edges: frozenset[frozenset] | None = None
         self._xy: np.ndarray | None = None  # positions (metres), one row per robot, in order
-        self._outbox: list[tuple[Message, tuple[Hashable, ...]]] = []
+        #: this tick's transmissions: (message, link table at sending, sender index,
+        #: addressee index: -1 everybody who hears it, -2 nobody)
+        self._outbox: list[tuple[Message, tuple, int, int]] = []
         self._inbox: dict[Hashable, list[Message]] = {r: [] for r in self.robots}
+        #: the last delivery, cut per robot when it asks: messages, message index of each
+        #: copy sorted by recipient, each robot's slice of them, who has not asked yet
+        self._batch: tuple[list, np.ndarray, list] | None = None
+        self._unread = np.zeros(len(self.robots), bool)
+        self._received = np.zeros(len(self.robots), np.int64)
         #: transmissions per robot (one per :meth:`send`)
         self.sent: dict[Hashable, int] = dict.fromkeys(self.robots, 0)
-        #: copies received per robot
-        self.received: dict[Hashable, int] = dict.fromkeys(self.robots, 0)
         #: copies lost to ``drop_prob`` or a blackout
         self.dropped = 0
         #: while True, every copy is lost (fault injection: a radio blackout)
@@ -150,8 +236,10 @@ class Radio:
     def remove(self, robot: Hashable) -> None:
         """The robot leaves (crash or recall): no links, nothing more sent to or by it."""
         self._present.pop(robot, None)
+        self._on_air[self._index[robot]] = False
         self._outbox = [m for m in self._outbox if m[0].sender != robot]
         self._inbox[robot].clear()
+        self._unread[self._index[robot]] = False  # what it had not read is lost
         self._relink()
 
     def restore(self, robot: Hashable) -> None:
@@ -160,6 +248,7 @@ class Radio:
             raise MjswarmError(f"radio: robot {robot!r} is not one of this radio's robots")
         if robot not in self._present:
             self._present = {r: None for r in self.robots if r in self._present or r == robot}
+            self._on_air[self._index[robot]] = True
 
     def neighbors(self, robot: Hashable) -> frozenset:
         """Robots that hear ``robot`` this tick (link-layer knowledge, no message cost)."""
@@ -219,17 +308,32 @@ class Radio:
         """Transmit ``payload`` to the sender's current neighbours (or only ``to``)."""
         if sender not in self._present:
             raise MjswarmError(f"radio: robot {sender!r} is not in the team")
+        check_immutable(payload)
         self.sent[sender] += 1
         if to is None:
-            recipients = self._ordered[sender]
+            addressee = -1
         else:
-            recipients = (to,) if to in self._neighbors[sender] else ()
-        self._outbox.append((Message(payload, to, sender), recipients))
+            addressee = self._index[to] if to in self._neighbors[sender] else -2
+        self._outbox.append((Message(payload, to, sender), self._table, self._index[sender], addressee))
 
     def receive(self, robot: Hashable) -> list[Message]:
         """Drain and return what ``robot`` has received (in delivery order)."""
-        inbox, self._inbox[robot] = self._inbox[robot], []
+        inbox = self._inbox[robot]
+        if inbox:
+            self._inbox[robot] = []
+        else:
+            inbox = []
+        k = self._index[robot]
+        if self._unread[k]:
+            self._unread[k] = False
+            messages, copies, bounds = self._batch
+            inbox += map(messages.__getitem__, copies[bounds[k]:bounds[k + 1]].tolist())
         return inbox
+
+    @property
+    def received(self) -> dict[Hashable, int]:
+        """Copies received per robot (a fresh dict)."""
+        return dict(zip(self.robots, self._received.tolist()))
 
     @property
     def pending(self) -> int:
@@ -245,17 +349,69 @@ class Radio:
     def _deliver(self) -> None:
         outbox, self._outbox = self._outbox, []
         self.last_batch = len(outbox)
-        present, inbox, received = self._present, self._inbox, self.received
-        lossless = not self.blackout and not self.drop_prob
-        for message, recipients in outbox:
-            for r in recipients:
-                if r not in present:
-                    continue
-                if not lossless and (self.blackout or self._rng.random() < self.drop_prob):
-                    self.dropped += 1
-                    continue
-                inbox[r].append(message)
-                received[r] += 1
+        self._fold_unread()
+        if not outbox:
+            return
+        message, recipient = self._copies(outbox)
+        keep = self._on_air[recipient]
+        message, recipient = message[keep], recipient[keep]
+        if self.blackout or self.drop_prob:
+            lost = (np.ones(len(recipient), bool) if self.blackout
+                    else self._rng.random(len(recipient)) < self.drop_prob)
+            self.dropped += int(lost.sum())
+            message, recipient = message[~lost], recipient[~lost]
+        if not len(recipient):
+            return
+        counts = np.bincount(recipient, minlength=len(self.robots))
+        self._received += counts
+        order = np.argsort(recipient, kind="stable")  # per recipient, in send order
+        bounds = np.concatenate([[0], np.cumsum(counts)]).tolist()
+        self._batch = ([m[0] for m in outbox], message[order], bounds)
+        self._unread = counts > 0
+
+    def _copies(self, outbox: list[tuple[Message, tuple, int, int]]) -> tuple[np.ndarray, np.ndarray]:
+        """Every copy of the outbox's messages as (message index, recipient index), in send
+        order and, within a message, in robot order: the senders' neighbours in the link
+        table of their sending (or the one addressee that hears it)."""
+        tables: dict[int, int] = {}  # id(table) -> its offset in the joined neighbour lists
+        parts: list[np.ndarray] = []
+        size = 0
+        start, count = [], []
+        for _, table, sender, addressee in outbox:
+            offset = tables.get(id(table))
+            if offset is None:
+                offset = tables[id(table)] = size
+                parts.append(table[0])
+                size += len(table[0])
+            if addressee == -1:
+                bounds = table[1]
+                start.append(offset + bounds[sender])
+                count.append(bounds[sender + 1] - bounds[sender])
+            elif addressee >= 0:
+                start.append(size)
+                count.append(1)
+                parts.append(np.array([addressee], np.intp))
+                size += 1
+            else:
+                start.append(0)
+                count.append(0)
+        joined = np.concatenate(parts) if len(parts) > 1 else parts[0]
+        count_a = np.array(count, np.intp)
+        total = int(count_a.sum())
+        message = np.repeat(np.arange(len(outbox)), count_a)
+        first = np.cumsum(count_a) - count_a
+        at = np.repeat(np.array(start, np.intp) - first, count_a) + np.arange(total)
+        return message, joined[at]
+
+    def _fold_unread(self) -> None:
+        """Copies of the last delivery that nobody asked for yet join their inboxes."""
+        if self._batch is not None and self._unread.any():
+            for k in np.flatnonzero(self._unread).tolist():
+                self._unread[k] = False
+                messages, copies, bounds = self._batch
+                self._inbox[self.robots[k]] += map(messages.__getitem__,
+                                                   copies[bounds[k]:bounds[k + 1]].tolist())
+        self._batch = None
 
     def _relink(self) -> None:
         if self.range_m is None:
@@ -300,7 +456,9 @@ class Radio:
         src = np.concatenate([ij[:, 0], ij[:, 1]])
         dst = np.concatenate([ij[:, 1], ij[:, 0]])
         order = np.lexsort((dst, src))
-        bounds = np.searchsorted(src[order], np.arange(len(self.robots) + 1)).tolist()
+        bounds_a = np.searchsorted(src[order], np.arange(len(self.robots) + 1))
+        self._table = (dst[order].astype(np.intp), bounds_a.astype(np.intp))
+        bounds = bounds_a.tolist()
         names = [self.robots[k] for k in dst[order].tolist()]
         self._ordered = {
             r: tuple(names[bounds[k] : bounds[k + 1]]) for k, r in enumerate(self.robots)
@@ -330,11 +488,13 @@ class Uplink:
 
     def send(self, robot: Hashable, payload: Any) -> None:
         """A robot's message to the station."""
+        check_immutable(payload, "station message")
         self._up.append(Message(payload, self.address, robot))
         self.sent_up += 1
 
     def reply(self, robot: Hashable, payload: Any) -> None:
         """The station's message to one robot."""
+        check_immutable(payload, "station message")
         self._down.append(Message(payload, robot, self.address))
         self.sent_down += 1
 

@@ -25,7 +25,10 @@ geoms by ``rgba`` or material alpha, geom groups). Ties go to the lower geom id,
 helpers inlined, and runs on ``threads`` threads (default 1: a second thread only pays on
 an otherwise idle core, and ``mjswarm sweep`` already fills the cores with processes; the
 parallel kernel is kept because numba compiles it to faster code than a plain loop, also
-on one thread).
+on one thread: the same loop compiled without ``parallel`` took 35 / 1383 / 4479 us against
+27 / 210 / 696 us for the rangefinders of 4 / 300 / 1000 robots). A cast sets numba's thread
+count to ``threads`` only when it differs (and leaves it there), so a process with one
+caster sets it once rather than twice per call.
 ``tests/test_raycast.py`` checks distances within 1e-9 and geom ids against ``mj_ray`` on
 random states.
 
@@ -182,18 +185,15 @@ class RayCaster:
         cells = self._flat(self._cells(centres[:, :2]))
         order = np.argsort(cells, kind="stable")
         robot_start = np.searchsorted(cells[order], self._cell_ids)
-        threads = numba.get_num_threads()
-        numba.set_num_threads(self.threads)
-        try:
-            _cast(np.ascontiguousarray(rays.origin, float), np.ascontiguousarray(rays.direction, float),
-                  np.asarray(rays.length, float), np.asarray(rays.exclude_body, np.int64), candidate,
-                  m.geom_type, m.geom_bodyid, d.geom_xpos, d.geom_xmat, m.geom_size, m.geom_rbound,
-                  self.always, self._origin, self.cell_m, self._shape_array,
-                  self._cell_start, self._cell_geoms, self._static_box, self._static_corner,
-                  robot_start, order, centres,
-                  self._robot_geom_start, self._robot_geoms, self.robot_radius_m, dist, geom)
-        finally:
-            numba.set_num_threads(threads)
+        if numba.get_num_threads() != self.threads:  # set once, not per call (see above)
+            numba.set_num_threads(self.threads)
+        _cast(np.ascontiguousarray(rays.origin, float), np.ascontiguousarray(rays.direction, float),
+              np.asarray(rays.length, float), np.asarray(rays.exclude_body, np.int64), candidate,
+              m.geom_type, m.geom_bodyid, d.geom_xpos, d.geom_xmat, m.geom_size, m.geom_rbound,
+              self.always, self._origin, self.cell_m, self._shape_array,
+              self._cell_start, self._cell_geoms, self._static_box, self._static_corner,
+              robot_start, order, centres,
+              self._robot_geom_start, self._robot_geoms, self.robot_radius_m, dist, geom)
         return dist, geom
 
     def _flat(self, cells: np.ndarray) -> np.ndarray:

@@ -50,7 +50,7 @@ from mjswarm.core.robot import (
     measure_geometry,
 )
 from mjswarm.core.sight import LineOfSight
-from mjswarm.core.world import Pose2D, yaw_quat
+from mjswarm.core.world import Pose2D, quiet_empty_prefix, yaw_quat
 
 #: One robot's sensor record: line rangefinders (m), IR distances (m, NaN = nothing
 #: within range), wheel encoders (rad), wheel speeds (rad/s), battery voltage (V).
@@ -71,6 +71,11 @@ GRID_SENSING_MIN_ROBOTS = 32
 #: How far (m) grid sensing looks along a rangefinder that has no cutoff before it asks
 #: ``mj_ray``: beyond any line-sensor reading of an upright robot (0.02 m).
 UNBOUNDED_PROBE_M = 0.1
+
+
+def _robot_count(spec: mujoco.MjSpec) -> int:
+    """Robots in an uncompiled world: bodies named ``.../ROOT_BODY``."""
+    return sum(1 for b in spec.bodies if b.name.endswith(f"/{ROOT_BODY}"))
 
 
 class Simulation:
@@ -117,10 +122,21 @@ class Simulation:
         if physics == "kinematic" and sensing == "mujoco":
             raise MjswarmError("the kinematic tier senses with the ray caster: use sensing "
                                "'grid' or 'auto' with physics 'kinematic'")
+        sensor_bit = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+        flags = spec.option.disableflags
+        if physics == "kinematic" or sensing == "grid" or (
+                sensing == "auto" and _robot_count(spec) >= GRID_SENSING_MIN_ROBOTS):
+            # compiling evaluates every sensor once (mj_setConst steps through mj_forward):
+            # for grid sensing, N robots' rangefinders against every geom, O(N^2), that
+            # nobody reads (20 s of a 10,000-robot build); the flag is set below anyway
+            spec.option.disableflags = flags | sensor_bit
         try:
-            self.model = spec.compile()
+            with quiet_empty_prefix():  # robots attached in groups (world.attach_robots)
+                self.model = spec.compile()
         except ValueError as exc:
             raise MjswarmError(f"world does not compile: {one_line(exc)}") from None
+        finally:
+            spec.option.disableflags = flags  # the caller's spec as it was
         self.data = mujoco.MjData(self.model)
         m = self.model
         self.n = sum(1 for b in range(m.nbody) if m.body(b).name.endswith(f"/{ROOT_BODY}"))
@@ -158,9 +174,7 @@ class Simulation:
         joints = m.body_jntadr[self.robot_bodies]
         self._qpos_adr = m.jnt_qposadr[joints]
         self._pose_qpos = self._qpos_adr[:, None] + np.arange(7)  # free joints: xyz, quat
-        geom_robot = np.full(m.ngeom, -1, dtype=np.int64)
-        for i, root in enumerate(self.robot_bodies):
-            geom_robot[np.isin(m.geom_bodyid, self._subtree(root))] = i
+        geom_robot = self._body_robot()[m.geom_bodyid]
         self.geom_robot = geom_robot
         if self.n == 0:
             raise MjswarmError("a simulation needs at least one robot")
@@ -187,6 +201,7 @@ class Simulation:
         self._rays = RayCaster(m, self.data, self.robot_bodies, geom_robot) if sensing == "grid" else None
         self._drive = KinematicDrive(self) if physics == "kinematic" else None
         self._no_torque = np.zeros((self.n, 2))
+        self._wheel_cmd = np.zeros((self.n, 2))  # set_velocity's buffer
         self._sense_now()
 
     @property
@@ -204,14 +219,17 @@ class Simulation:
             self._sight = LineOfSight(self)
         return self._sight
 
-    def _subtree(self, root: int) -> np.ndarray:
-        """Body ids of ``root`` and all its descendants."""
+    def _body_robot(self) -> np.ndarray:
+        """The robot whose subtree holds each body, -1 for none (bodies come in
+        depth-first order, so a parent precedes its children): O(nbody)."""
         m = self.model
-        inside = np.zeros(m.nbody, bool)
-        inside[root] = True
-        for b in range(root + 1, m.nbody):
-            inside[b] = inside[m.body_parentid[b]]
-        return np.flatnonzero(inside)
+        owner = np.full(m.nbody, -1, np.int64)
+        owner[self.robot_bodies] = np.arange(self.n)
+        own, parent = owner.tolist(), m.body_parentid.tolist()
+        for b in range(1, m.nbody):
+            if own[b] < 0:
+                own[b] = own[parent[b]]
+        return np.array(own, np.int64)
 
     # ------------------------------------------------------------------ commands
     def set_wheel_speeds(self, omega_rad_s: np.ndarray) -> None:
@@ -233,13 +251,27 @@ class Simulation:
         wheel limit is scaled down as a whole, keeping the path's curvature ``omega / v``.
         """
         g = self.geometry
-        v = np.broadcast_to(np.asarray(v_m_s, float), (self.n,))
-        w = np.broadcast_to(np.asarray(omega_rad_s, float), (self.n,))
-        wheels = np.stack([v - w * g.track_m / 2.0, v + w * g.track_m / 2.0], axis=1)
+        v = np.asarray(v_m_s, float)
+        w = np.asarray(omega_rad_s, float)
+        if v.shape != (self.n,):
+            v = np.broadcast_to(v, (self.n,))
+        if w.shape != (self.n,):
+            w = np.broadcast_to(w, (self.n,))
+        # into a buffer kept for it, in the operations (and so the roundings) of
+        # wheels = [v - w b / 2, v + w b / 2] / r, scaled down by max / peak where over
+        turn = w * g.track_m
+        turn /= 2.0
+        wheels = self._wheel_cmd
+        np.subtract(v, turn, out=wheels[:, 0])
+        np.add(v, turn, out=wheels[:, 1])
         wheels /= g.wheel_radius_m
-        peak = np.abs(wheels).max(axis=1, keepdims=True)
-        scale = np.where(peak > g.max_wheel_speed_rad_s, g.max_wheel_speed_rad_s / np.maximum(peak, 1e-12), 1.0)
-        self.set_wheel_speeds(wheels * scale)
+        peak = np.abs(wheels).max(axis=1)
+        over = peak > g.max_wheel_speed_rad_s
+        if over.any():
+            wheels[over] *= (g.max_wheel_speed_rad_s / np.maximum(peak[over], 1e-12))[:, None]
+        if not np.isfinite(peak).all():
+            raise MjswarmError("wheel speed commands must be finite")
+        self.data.ctrl[self._actuators] = wheels
 
     def place_robot(self, i: int, pose: Pose2D) -> None:
         """Put robot ``i`` down at ``pose``, at rest (the experimenter's hand, not physics)."""
