@@ -55,7 +55,8 @@ def exploration(arena: str, robots: int) -> None:
 def bench(physics: str, robots: int, ticks: int) -> None:
     """The bench's world and loop (``mjswarm bench``): sensing, bearings, radio with line
     of sight, a heartbeat per robot per tick, the speed rule; also hashes what robots heard."""
-    from mjswarm.outputs.bench import bench_loop, bench_world
+    from mjswarm.experiments.bench import bench_loop
+    from mjswarm.worlds.bench import bench_world
 
     digest = hashlib.sha256()
     sim = bench_world(robots, physics=physics)

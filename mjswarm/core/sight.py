@@ -3,7 +3,7 @@
 Robot ``k`` sees robot ``p`` when a ray from ``k``'s centre at ``RAY_HEIGHT_M``, towards
 ``p``'s centre, hits ``p`` first; only collision geoms (``COLLISION_GROUP``: robots, walls, the floor) block.
 The bearing sensor (:mod:`mjswarm.core.bearing`) asks this for the ordered pairs in its field of
-view, the radio (:func:`mjswarm.experiments.awareness.sight_blocker`) for every pair in range
+view, the radio (:func:`mjswarm.core.radio.sight_blocker`) for every pair in range
 one way, and the way back only where the way there is clear (a link needs both).
 :class:`LineOfSight` answers each ordered pair once per world state (the simulation's
 ``state_version``), so the bearing sensor's rays that the radio has already cast in a tick

@@ -100,6 +100,15 @@ class World(ABC):
         """The robots the loop steps this tick: those on the floor."""
         return np.flatnonzero(self.present).tolist()
 
+    def on_floor(self, i) -> bool:
+        """Whether robot ``i`` is on the floor (a robot that leaves it and comes back
+        starts a new episode: the loop resets its controller)."""
+        return bool(self.present[i])
+
+    def robots_on_floor(self) -> int:
+        """How many robots are on the floor."""
+        return int(np.count_nonzero(self.present))
+
     @property
     def contacts(self) -> int | None:
         """Robot-robot contact events so far (None: a world without bodies)."""
@@ -306,9 +315,9 @@ class Loop:
     def _enter(self, robots: list) -> None:
         """Reset the controllers of robots that entered the floor since the last tick
         (before their first step, and after each time they were off the floor)."""
-        on_floor, present = self._on_floor, self.world.present
-        if len(on_floor) != int(np.count_nonzero(present)):  # someone left the floor
-            self._on_floor = on_floor = {i for i in on_floor if present[i]}
+        on_floor, world = self._on_floor, self.world
+        if len(on_floor) != world.robots_on_floor():  # someone left the floor
+            self._on_floor = on_floor = {i for i in on_floor if world.on_floor(i)}
         if on_floor.issuperset(robots):
             return
         for i in robots:

@@ -35,6 +35,12 @@ class StaticWorld(World):
     def active(self) -> list[Hashable]:
         return list(self.radio.present)
 
+    def on_floor(self, i: Hashable) -> bool:
+        return i in self.radio.present
+
+    def robots_on_floor(self) -> int:
+        return len(self.radio.present)
+
     def commanded_speeds(self) -> np.ndarray:
         return np.zeros(self.n)
 
