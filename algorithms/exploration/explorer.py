@@ -97,11 +97,12 @@ RELAY_SPACING_M = 0.3
 
 
 class VertexCall(NamedTuple):
-    """One call of the strategy at a vertex: when, the beacon, whether the robot had
-    just arrived by an edge (else: a launch or an idle wake-up), and the decision."""
+    """One call of the strategy at a vertex: when, the beacon's id (never the beacon: a
+    handle works only in the tick it was handed out), whether the robot had just arrived
+    by an edge (else: a launch or an idle wake-up), and the decision."""
 
     time_s: float
-    beacon: Any
+    beacon_id: Any
     arrived: bool
     decision: Decision
 
@@ -227,7 +228,7 @@ class Explorer(Controller):
         if self.connected.relay_trips != self._trips:
             self._trips = self.connected.relay_trips
             self._events.append(RelayTrip())
-            self._set_out(observation.time_s, out)
+            self._set_out(observation, out)
 
     def _leash(self, now: int, command: Command, around) -> Command:
         """Rules 3-6 on this tick's command: it stands where the leash (or a wall it met
@@ -250,7 +251,7 @@ class Explorer(Controller):
                                     self._cut if self._way in self._occluded else ())
         return command._replace(messages=tuple(out))
 
-    def _set_out(self, now_s: float, out: list[Message]) -> None:
+    def _set_out(self, observation: Observation, out: list[Message]) -> None:
         """Rule 6: it accepted a relay mission. On an edge its plan starts with the walk
         back; on a centre where it waits for a grant it withdraws its request (the leg
         it had decided on is walked back at once: it never left) and decides anew."""
@@ -262,9 +263,9 @@ class Explorer(Controller):
             out.append(Message(Withdraw(), STATION))
         self._departure, self._asked, self._withdrawn = None, None, False
         self.connected.arrived_back()
-        # it stands where it made its last call: that beacon (its grant may have moved
-        # the station's record on already)
-        self._vertex_call(self.calls[-1].beacon, now_s, False, out, back=True)
+        # it stands where it made its last call, and reads that beacon now (the station
+        # serves it to the robot it granted the vertex, or is letting leave it)
+        self._vertex_call(observation.beacon, observation.time_s, False, out, back=True)
 
     def _retrace(self, now: int, out: list[Message], around) -> Command:
         """A parent's link is gone (a wall came between them: the leash knows ranges, not
@@ -423,7 +424,7 @@ class Explorer(Controller):
         consulted = cx is None or cx.consulted
         if consulted and self.strategy.stored_angles is not None:  # re-anchoring
             nav.reanchor(self.strategy.stored_angles)
-        self.calls.append(VertexCall(now_s, beacon, arrived and not back, decision))
+        self.calls.append(VertexCall(now_s, beacon.id, arrived and not back, decision))
         mapped = tuple(self.strategy.map_edges())
         self._events.append(VertexCalled(arrived and not back, decision.action, decision.angle,
                                          beacon.id, repr(beacon.data), mapped))

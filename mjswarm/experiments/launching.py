@@ -59,8 +59,8 @@ class Launching(LoopFunctions):
         if now - self.last_launch_s < self.interval_s:
             return
         near = np.hypot(*(self.world.true_poses()[:, :2] - self.root_xy).T) < ROOT_CLEAR_M
-        present, done = self.world.present, self.roster.done
-        if any(present[j] and j not in done for j in np.flatnonzero(near).tolist()):
+        present, done = self.world.present, self.roster.is_done
+        if any(present[j] and not done(j) for j in np.flatnonzero(near).tolist()):
             return  # O(robots near the root), never O(K^2)
         if self.stations.avoid and self.root in self.stations.stations.holder:
             return

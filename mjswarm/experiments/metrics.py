@@ -35,9 +35,17 @@ class Roster:
     or docked) and when a robot last reached a vertex (or was launched)."""
 
     def __init__(self, docked=()) -> None:
-        self.done: set = set(docked)
+        self.docked = frozenset(docked)
+        self.finished: set[int] = set()  # stopped, declared or switched off
         self.failed: set[int] = set()
         self.last_progress_s = 0.0
+
+    def is_done(self, i: int) -> bool:
+        return i in self.finished or i in self.docked
+
+    @property
+    def count_done(self) -> int:
+        return len(self.finished | self.docked)
 
 
 class ExplorationMetrics(LoopFunctions):
@@ -73,9 +81,9 @@ class ExplorationMetrics(LoopFunctions):
 
     def _switched_off(self, i: int, reason: str) -> None:
         """A robot switched off (a fault) stops, unless it had stopped or declared."""
-        if i not in self.roster.done:
+        if i not in self.roster.finished:
             self._stop(i, reason, self.world.time_s)
-        self.roster.done.add(i)
+        self.roster.finished.add(i)
         self.roster.failed.add(i)
 
     def before_step(self, loop: Loop) -> None:
@@ -94,9 +102,9 @@ class ExplorationMetrics(LoopFunctions):
             elif kind is SpeedChanged:
                 loop.event(f"R{i + 1} speed {event.old_m_s:.3f} -> {event.new_m_s:.3f} m/s", i)
             elif kind is Stopped:
-                if i not in self.roster.done:
+                if i not in self.roster.finished:
                     self._stop(i, event.reason, now)
-                self.roster.done.add(i)
+                self.roster.finished.add(i)
             elif kind is Declared:
                 self.declared_map = event.map_edges
             elif kind is RelayTrip:
@@ -120,7 +128,7 @@ class ExplorationMetrics(LoopFunctions):
             self.beacon_vertex.setdefault(call.beacon_id, vertex)
         if call.action == "done":
             self.declared = (now, i, vertex)
-            self.roster.done.add(i)
+            self.roster.finished.add(i)
             loop.event(f"R{i + 1} declares completion at {vertex}", i)
             loop.event(f"R{i + 1} declared completion at {vertex}")
 
@@ -146,7 +154,7 @@ class ExplorationMetrics(LoopFunctions):
             self.ended_because = "completed"
         elif self.infeasible:
             self.ended_because = self.infeasible_reason(self.paths)
-        elif len(self.roster.done) >= self.world.n:
+        elif self.roster.count_done >= self.world.n:
             self.ended_because = "all robots stopped"
         elif (self.stall_timeout_s is not None
               and self.world.time_s - self.roster.last_progress_s > self.stall_timeout_s):

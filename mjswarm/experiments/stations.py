@@ -222,11 +222,12 @@ class StationService(LoopFunctions):
     # ------------------------------------------------------------------ beacons
     def beacon_at(self, i: int) -> str | None:
         """The vertex whose beacon robot ``i`` may read now: the one whose centre it
-        stands on, if the station there granted it that vertex (or launched it there)."""
+        stands on, if the station there granted it that vertex (or launched it there), or
+        has granted it the next one and not yet seen it leave."""
         vertex, distance = self.nearest(i)
         if distance >= ON_VERTEX_M:
             return None
-        if self.avoid and self.target[i] != vertex:
+        if self.avoid and vertex != self.target[i] and vertex != self.leaving[i]:
             return None
         return vertex
 
