@@ -35,16 +35,16 @@ def test_a_rejected_run_leaves_an_existing_recording_byte_for_byte(tmp_path, cap
 
 
 def test_an_interrupted_run_keeps_a_valid_partial_recording(tmp_path, capsys, monkeypatch):
-    step = mjswarm.experiments.exploration.EmbodiedExploration.step
+    step = mjswarm.experiments.exploration.EmbodiedExploration.ticked
     calls = {"n": 0}
 
-    def interrupt_after_a_while(self):
+    def interrupt_after_a_while(self, *args):
         calls["n"] += 1
         if calls["n"] == 300:
             raise KeyboardInterrupt
-        step(self)
+        step(self, *args)
 
-    monkeypatch.setattr(mjswarm.experiments.exploration.EmbodiedExploration, "step", interrupt_after_a_while)
+    monkeypatch.setattr(mjswarm.experiments.exploration.EmbodiedExploration, "ticked", interrupt_after_a_while)
     target = tmp_path / "run.rrd"
     target.write_bytes(b"old")
     assert main(["explore", "--arena", "arena1", "--robots", "2", "--record",

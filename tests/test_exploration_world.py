@@ -27,7 +27,8 @@ class Script(Strategy):
         self.answers = list(answers)
 
     def on_vertex(self, beacon, angles, arrived_by):
-        Script.log.append((self.index, beacon, arrived_by))
+        # the vertex's beacon behind the handle (a handle lives one tick)
+        Script.log.append((self.index, getattr(beacon, "_beacon", beacon), arrived_by))
         answer = self.answers.pop(0) if self.answers else "idle"
         return {"idle": IDLE, "done": DONE}.get(answer) or go(answer)
 

@@ -121,16 +121,16 @@ def test_outputs_get_the_mode_open_would_give_and_keep_an_existing_one(tmp_path,
 
 
 def interrupt_after(monkeypatch, ticks: int) -> None:
-    step = mjswarm.experiments.exploration.EmbodiedExploration.step
+    step = mjswarm.experiments.exploration.EmbodiedExploration.ticked
     calls = {"n": 0}
 
-    def step_then_interrupt(self):
+    def step_then_interrupt(self, *args):
         calls["n"] += 1
         if calls["n"] == ticks:
             raise KeyboardInterrupt
-        step(self)
+        step(self, *args)
 
-    monkeypatch.setattr(mjswarm.experiments.exploration.EmbodiedExploration, "step",
+    monkeypatch.setattr(mjswarm.experiments.exploration.EmbodiedExploration, "ticked",
                         step_then_interrupt)
 
 

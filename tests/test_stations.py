@@ -123,18 +123,18 @@ def test_a_swap_grants_both_robots_and_tells_each_its_vertex_is_not_yet_clear():
     run = EmbodiedExploration(load_arena("fig9"), make_minds("incidence-dfs", 2),
                               EmbodiedConfig(), 0)
     u, w = load_arena("fig9").edges[0]
-    run.launch_queue.clear()
-    run.target = [u, w]
-    run.stations.occupy(0, u)
-    run.stations.occupy(1, w)
-    run.stations.request(0, u, w, 0.0)
-    run.stations.request(1, w, u, 0.0)
-    run.before_step(run.loop)
+    run.launching.queue.clear()
+    run.stations.target[:] = [u, w]
+    run.stations.stations.occupy(0, u)
+    run.stations.stations.occupy(1, w)
+    run.stations.stations.request(0, u, w, 0.0)
+    run.stations.stations.request(1, w, u, 0.0)
+    run.stations.before_step(run.loop)
     run.uplink.step()
     replies = [[m.payload for m in run.uplink.receive_for(i)] for i in (0, 1)]
     assert replies == [[EntryGranted(clear=False)], [EntryGranted(clear=False)]]
-    assert run.target == [w, u] and run.leaving == [u, w]
-    run._station_receives(0, LeftVertex())  # R1 is in its corridor: u is free for R2
+    assert run.stations.target == [w, u] and run.stations.leaving == [u, w]
+    run.stations._receive(0, LeftVertex())  # R1 is in its corridor: u is free for R2
     run.uplink.step()
     assert [m.payload for m in run.uplink.receive_for(1)] == [VertexClear()]
     assert run.uplink.receive_for(0) == []
@@ -152,17 +152,17 @@ def test_a_withdrawn_request_is_dropped(lattice):
 def _on_fig9(k: int = 2) -> tuple[EmbodiedExploration, str, str]:
     run = EmbodiedExploration(load_arena("fig9"), make_minds("incidence-dfs", k),
                               EmbodiedConfig(), 0)
-    run.launch_queue.clear()
+    run.launching.queue.clear()
     u, w = load_arena("fig9").edges[0]
     return run, u, w
 
 
 def _granted(run, i, u, w):
     """Robot ``i`` on ``u`` asks for the edge to ``w`` and gets it."""
-    run.target[i] = u
-    run.stations.occupy(i, u)
-    run._station_receives(i, EntryRequest(_angle(run, u, w)))
-    run.before_step(run.loop)
+    run.stations.target[i] = u
+    run.stations.stations.occupy(i, u)
+    run.stations._receive(i, EntryRequest(_angle(run, u, w)))
+    run.stations.before_step(run.loop)
     run.uplink.step()
     return [m.payload for m in run.uplink.receive_for(i)]
 
@@ -174,10 +174,10 @@ def _angle(run, u, w):
 def test_a_robot_turning_back_short_of_its_corridor_gets_its_vertex_back_at_once():
     run, u, w = _on_fig9()
     assert _granted(run, 0, u, w) == [EntryGranted(True, _angle(run, u, w))]
-    run._station_receives(0, TurnedBack(from_lane=False))
+    run.stations._receive(0, TurnedBack(from_lane=False))
     run.uplink.step()
     assert [m.payload for m in run.uplink.receive_for(0)] == [EntryGranted(clear=True)]
-    assert run.target[0] == u and run.leaving[0] is None and run.stations.holder == {u: 0}
+    assert run.stations.target[0] == u and run.stations.leaving[0] is None and run.stations.stations.holder == {u: 0}
 
 
 def test_a_robot_turning_back_from_its_lane_waits_for_its_vertex_like_a_centre():
@@ -185,18 +185,18 @@ def test_a_robot_turning_back_from_its_lane_waits_for_its_vertex_like_a_centre()
     from its lane: granted when ``u`` is free, with the vertex ahead freed at once."""
     run, u, w = _on_fig9()
     _granted(run, 0, u, w)
-    run._station_receives(0, LeftVertex())
-    run.stations.occupy(1, u)
-    run.target[1] = u
-    run._station_receives(0, TurnedBack(from_lane=True))
-    assert run.stations.holder == {u: 1} and run.stations.requests[0].at is None
-    run.before_step(run.loop)
-    assert run.stations.holder == {u: 1}  # u is held: it waits
-    run.stations.release(1, u)
-    run.before_step(run.loop)
+    run.stations._receive(0, LeftVertex())
+    run.stations.stations.occupy(1, u)
+    run.stations.target[1] = u
+    run.stations._receive(0, TurnedBack(from_lane=True))
+    assert run.stations.stations.holder == {u: 1} and run.stations.stations.requests[0].at is None
+    run.stations.before_step(run.loop)
+    assert run.stations.stations.holder == {u: 1}  # u is held: it waits
+    run.stations.stations.release(1, u)
+    run.stations.before_step(run.loop)
     run.uplink.step()
     assert [m.payload for m in run.uplink.receive_for(0)] == [EntryGranted(True, None)]
-    assert run.target[0] == u and run.stations.holder == {u: 0}
+    assert run.stations.target[0] == u and run.stations.stations.holder == {u: 0}
 
 
 def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws():
@@ -204,21 +204,21 @@ def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws()
     into its old area gets no answer (it goes on), and one that withdraws leaves the
     other waiting until it has left its area."""
     run, u, w = _on_fig9()
-    run.target = [u, w]
-    run.stations.occupy(0, u)
-    run.stations.occupy(1, w)
+    run.stations.target[:] = [u, w]
+    run.stations.stations.occupy(0, u)
+    run.stations.stations.occupy(1, w)
     for i, (a, b) in enumerate(((u, w), (w, u))):
-        run._station_receives(i, EntryRequest(_angle(run, a, b)))
-    run.before_step(run.loop)
+        run.stations._receive(i, EntryRequest(_angle(run, a, b)))
+    run.stations.before_step(run.loop)
     run.uplink.step()
     for i in (0, 1):
         run.uplink.receive_for(i)
-    run._station_receives(0, TurnedBack(from_lane=False))
+    run.stations._receive(0, TurnedBack(from_lane=False))
     run.uplink.step()
-    assert run.uplink.receive_for(0) == [] and run.target == [w, u]
-    run._station_receives(1, Withdraw())
-    assert run.target[1] == w and run.leaving[1] == w  # robot 0 still waits for it to go
-    assert run.stations.holder == {w: 0}
+    assert run.uplink.receive_for(0) == [] and run.stations.target == [w, u]
+    run.stations._receive(1, Withdraw())
+    assert run.stations.target[1] == w and run.stations.leaving[1] == w  # robot 0 still waits for it to go
+    assert run.stations.stations.holder == {w: 0}
     run.uplink.step()
     assert run.uplink.receive_for(0) == []  # no VertexClear for robot 0
 
@@ -226,5 +226,5 @@ def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws()
 def test_a_withdrawn_clear_grant_is_taken_back():
     run, u, w = _on_fig9()
     _granted(run, 0, u, w)
-    run._station_receives(0, Withdraw())
-    assert run.target[0] == u and run.leaving[0] is None and run.stations.holder == {u: 0}
+    run.stations._receive(0, Withdraw())
+    assert run.stations.target[0] == u and run.stations.leaving[0] is None and run.stations.stations.holder == {u: 0}

@@ -80,6 +80,49 @@ class Beacon:
         self.data: Any = None
 
 
+class ExpiredBeacon(RuntimeError):
+    """A beacon handle was used after the tick it was handed out in."""
+
+
+class BeaconHandle:
+    """What a world hands a robot of the beacon it stands on: reads and writes go to the
+    vertex's :class:`Beacon` during the tick it was handed out in; afterwards (the world
+    calls :meth:`expire` when it steps) any use raises :class:`ExpiredBeacon`. A robot
+    that wants to remember a vertex keeps its ``id``, never the handle."""
+
+    __slots__ = ("_beacon",)
+
+    def __init__(self, beacon: Beacon) -> None:
+        self._beacon = beacon
+
+    def _live(self) -> Beacon:
+        beacon = self._beacon
+        if beacon is None:
+            raise ExpiredBeacon("a beacon handle is good only during the tick it was "
+                                "handed out in; keep its id instead")
+        return beacon
+
+    @property
+    def id(self) -> str | None:
+        return self._live().id
+
+    @id.setter
+    def id(self, value: str | None) -> None:
+        self._live().id = value
+
+    @property
+    def data(self) -> Any:
+        return self._live().data
+
+    @data.setter
+    def data(self, value: Any) -> None:
+        self._live().data = value
+
+    def expire(self) -> None:
+        """The tick is over: the handle no longer reaches the beacon."""
+        self._beacon = None
+
+
 class Strategy(ABC):
     """A per-robot exploration mind; one instance per robot.
 

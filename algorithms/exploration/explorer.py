@@ -58,6 +58,15 @@ from typing import Any, NamedTuple
 
 from algorithms.collision import CollisionRule
 from algorithms.exploration.base import AngleMismatch, Decision, Strategy
+from algorithms.exploration.events import (
+    Declared,
+    Infeasible,
+    RelayTrip,
+    SpeedChanged,
+    SpeedRuleFired,
+    Stopped,
+    VertexCalled,
+)
 from algorithms.exploration.relay import ConnectedExplorer
 from algorithms.exploration.tether import Tether
 from algorithms.exploration.entry import (
@@ -88,11 +97,12 @@ RELAY_SPACING_M = 0.3
 
 
 class VertexCall(NamedTuple):
-    """One call of the strategy at a vertex: when, the beacon, whether the robot had
-    just arrived by an edge (else: a launch or an idle wake-up), and the decision."""
+    """One call of the strategy at a vertex: when, the beacon's id (never the beacon: a
+    handle works only in the tick it was handed out), whether the robot had just arrived
+    by an edge (else: a launch or an idle wake-up), and the decision."""
 
     time_s: float
-    beacon: Any
+    beacon_id: Any
     arrived: bool
     decision: Decision
 
@@ -159,12 +169,25 @@ class Explorer(Controller):
         self._withdrawn = False  # gave a grant back: it holds (asks again once it may go)
         self._leaving = False  # holds the vertex it left until it is in its corridor
         self._clear = True  # the vertex it goes to is clear of its previous holder
+        self._events: list = []  # what it reports this tick (``Command.events``)
+        self._said_speed = speed_m_s  # its speed as last reported
 
     def reset(self) -> None:
         """Put on a vertex centre (a launch): scan, then call the strategy."""
         self.nav.begin_at_vertex()
 
     def step(self, observation: Observation) -> Command:
+        """This tick's command, with what it reports (:mod:`algorithms.exploration.events`)."""
+        command = self._step(observation)
+        if self.speed_m_s != self._said_speed and self.nav.on_lane:
+            self._events.append(SpeedChanged(self._said_speed, self.speed_m_s))
+        self._said_speed = self.speed_m_s
+        if self._events:
+            command = command._replace(events=tuple(self._events))
+            self._events = []
+        return command
+
+    def _step(self, observation: Observation) -> Command:
         out: list[Message] = []
         now = round(observation.time_s / self.control_dt_s)
         if self.table is not None:
@@ -189,8 +212,9 @@ class Explorer(Controller):
             if self.tether is None:
                 return command
             command = self._leash(now, command, around)
-        if self.tether.stalled(now):  # rule 5 (a robot whose parent failed judges it too)
-            self.infeasible = True
+        if self.tether.stalled(now) and not self.infeasible:  # rule 5 (a robot whose
+            self.infeasible = True  # parent failed judges it too)
+            self._events.append(Infeasible())
         return command
 
     def _hear(self, now: int, observation: Observation, around, out: list[Message]) -> None:
@@ -203,7 +227,8 @@ class Explorer(Controller):
             out.append(Message(self._asked, STATION))
         if self.connected.relay_trips != self._trips:
             self._trips = self.connected.relay_trips
-            self._set_out(observation.time_s, out)
+            self._events.append(RelayTrip())
+            self._set_out(observation, out)
 
     def _leash(self, now: int, command: Command, around) -> Command:
         """Rules 3-6 on this tick's command: it stands where the leash (or a wall it met
@@ -226,7 +251,7 @@ class Explorer(Controller):
                                     self._cut if self._way in self._occluded else ())
         return command._replace(messages=tuple(out))
 
-    def _set_out(self, now_s: float, out: list[Message]) -> None:
+    def _set_out(self, observation: Observation, out: list[Message]) -> None:
         """Rule 6: it accepted a relay mission. On an edge its plan starts with the walk
         back; on a centre where it waits for a grant it withdraws its request (the leg
         it had decided on is walked back at once: it never left) and decides anew."""
@@ -238,9 +263,9 @@ class Explorer(Controller):
             out.append(Message(Withdraw(), STATION))
         self._departure, self._asked, self._withdrawn = None, None, False
         self.connected.arrived_back()
-        # it stands where it made its last call: that beacon (its grant may have moved
-        # the station's record on already)
-        self._vertex_call(self.calls[-1].beacon, now_s, False, out, back=True)
+        # it stands where it made its last call, and reads that beacon now (the station
+        # serves it to the robot it granted the vertex, or is letting leave it)
+        self._vertex_call(observation.beacon, observation.time_s, False, out, back=True)
 
     def _retrace(self, now: int, out: list[Message], around) -> Command:
         """A parent's link is gone (a wall came between them: the leash knows ranges, not
@@ -277,7 +302,10 @@ class Explorer(Controller):
         speed = self.cruise_m_s
         if self.rule is not None:
             if nav.on_lane:  # the rule governs edge traversals
+                fired = self.rule.activations
                 speed = self.rule.update(observation.bearings)
+                if self.rule.activations != fired:
+                    self._events.append(SpeedRuleFired(self.rule.activations - fired))
             else:
                 self.rule.forget_bearings()
             # a vertex area it gives up is one it never backs into (``_retrace``)
@@ -335,9 +363,17 @@ class Explorer(Controller):
             self.rule.crossed_vertex()  # a new traversal begins: eq. (34)
 
     def telemetry(self) -> dict[str, float]:
-        """Its speed (m/s), vertex calls so far, and whether it is stopped for good."""
-        return {"speed_m_s": self.speed_m_s, "vertex_calls": len(self.calls),
-                "halted": float(self.halted is not None)}
+        """Its speed (m/s), vertex calls so far, whether it is stopped for good, its
+        odometry's heading (rad, its own frame: the beacons'), whether it follows a lane
+        between two vertices (1.0) and, with a connectivity table, whether the table
+        believes it biconnected to the reference (1.0)."""
+        out = {"speed_m_s": self.speed_m_s, "vertex_calls": len(self.calls),
+               "halted": float(self.halted is not None),
+               "heading_rad": self.nav.odometry.theta,
+               "on_edge": float(self.nav.state is NavigatorState.ON_EDGE)}
+        if self.table is not None:
+            out["biconnected"] = float(self.table.is_doubly_connected())
+        return out
 
     # -- events and vertex calls -----------------------------------------------------------
     def _on_events(self, observation: Observation, out: list[Message]) -> None:
@@ -388,7 +424,10 @@ class Explorer(Controller):
         consulted = cx is None or cx.consulted
         if consulted and self.strategy.stored_angles is not None:  # re-anchoring
             nav.reanchor(self.strategy.stored_angles)
-        self.calls.append(VertexCall(now_s, beacon, arrived and not back, decision))
+        self.calls.append(VertexCall(now_s, beacon.id, arrived and not back, decision))
+        mapped = tuple(self.strategy.map_edges())
+        self._events.append(VertexCalled(arrived and not back, decision.action, decision.angle,
+                                         beacon.id, repr(beacon.data), mapped))
         if decision.action == "go":
             self._departure = min(nav.edge_angles, key=lambda a: abs(
                 math.remainder(a - decision.angle, 2 * math.pi)))
@@ -401,6 +440,7 @@ class Explorer(Controller):
             self._idle_since = now_s
         elif decision.action == "done":
             self.declared = True
+            self._events.append(Declared(mapped))
         else:
             raise ValueError(f"the strategy answered an unknown decision {decision!r}")
 
@@ -436,5 +476,6 @@ class Explorer(Controller):
     def _halt(self, reason: str, out: list[Message]) -> None:
         if self.halted is None:
             self.halted = reason
+            self._events.append(Stopped(reason))
             if self.rule is not None:
                 out.append(Message(Halted(reason), STATION))

@@ -81,10 +81,11 @@ EXPLORE, TRANSIT, RELAY, RETURN, RETREAT, RESERVE, RETIRED = (
 
 
 class Leg(NamedTuple):
-    """An edge as a robot walks it: the beacon it left, the incidence angle it left by,
-    and the angle of the same edge at the far vertex (None while under way)."""
+    """An edge as a robot walks it: the id of the beacon it left (an opaque name, never
+    the beacon: messages carry it), the incidence angle it left by, and the angle of the
+    same edge at the far vertex (None while under way)."""
 
-    start: Any
+    start: Hashable
     depart: float
     arrive: float | None = None
 
@@ -191,7 +192,7 @@ class ConnectedExplorer:
         self.relay_since = 0
         self.had_child_at: int | None = None
         self.progressed = False
-        self._root = None
+        self._root: Hashable | None = None  # the root's beacon id
         self._tick = 0
         self._wanted: RelayWanted | None = None
         self.last_wanted = 0  # tick of the last request heard
@@ -270,6 +271,12 @@ class ConnectedExplorer:
             self.mind.arrive(beacon, angles, arrived_by)
 
     def on_vertex(self, beacon, angles: Sequence[float], arrived_by: float | None) -> Decision:
+        decision = self._on_vertex(beacon, angles, arrived_by)
+        if self._root is None:  # the first call, at the root: its beacon is named now
+            self._root = beacon.id
+        return decision
+
+    def _on_vertex(self, beacon, angles: Sequence[float], arrived_by: float | None) -> Decision:
         self.idle = self.consulted = False
         if self.plan and self.plan[0] == ("back",):  # planned on the edge it has finished
             self.plan = self._way(*self._goal)
@@ -297,25 +304,24 @@ class ConnectedExplorer:
         return decision
 
     def _depart(self, beacon, angle: float) -> Decision:
-        self.leg, self.backwards, self.progress = Leg(beacon, angle), False, 0.0
+        self.leg, self.backwards, self.progress = Leg(beacon.id, angle), False, 0.0
         self.under_way = False
         return go(angle)
 
     def _walked_to(self, beacon, arrived_by: float | None) -> None:
         """Keep the route loop-free: arriving where a leg of it started cuts it there."""
         if self.leg is None:
-            if self._root is None:
-                self._root = beacon
-            return
+            return  # the root's id is kept after its first call (:meth:`on_vertex`)
         done = Leg(self.leg.start, self.leg.depart, arrived_by)
         self.leg, self.under_way = None, False
         if self.backwards:
             return  # back at the start of the leg: the route is as it was
+        here = beacon.id  # None: a beacon nobody has named, so no vertex of the route
         starts = [leg.start for leg in self.route]
-        if beacon is self._root:
+        if here is not None and here == self._root:
             self.route = []
-        elif beacon in starts:
-            del self.route[starts.index(beacon):]
+        elif here is not None and here in starts:
+            del self.route[starts.index(here):]
         else:
             self.route.append(done)
 
@@ -436,7 +442,7 @@ def _common(a: Sequence[Leg], b: Sequence[Leg]) -> int:
     """How many legs two routes from the root share."""
     n = 0
     for x, y in zip(a, b):
-        if x.start is not y.start or x.depart != y.depart:
+        if x.start != y.start or x.depart != y.depart:
             break
         n += 1
     return n

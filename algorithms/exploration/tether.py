@@ -62,7 +62,7 @@ import math
 from collections.abc import Collection, Hashable, Mapping, Sequence
 from typing import NamedTuple
 
-from algorithms.robot import Message
+from algorithms.robot import Command, Controller, Message, Observation
 
 #: Ticks a fresh adoption holds the parent before the child's beats must name it
 #: (request, answer and the first beat naming the parent: one tick each, plus one).
@@ -297,3 +297,15 @@ class BaseStation:
         out.append(Message(Beat(self.parents, self.depth, True, self.last_progress,
                                 self.known_edges)))
         return out
+
+
+class FixedNode(Controller):
+    """A :class:`BaseStation` (the base, or the robot docked at it) as the controller of a
+    fixed radio node that the loop steps with the robots: it reads its radio and answers
+    with messages, nothing else."""
+
+    def __init__(self, station: BaseStation) -> None:
+        self.station = station
+
+    def step(self, observation: Observation) -> Command:
+        return Command(messages=tuple(self.station.step(observation.inbox)))

@@ -52,6 +52,8 @@ def run_embodied(args) -> dict:
     from mjswarm.experiments.exploration import EmbodiedConfig
     from mjswarm.experiments.faults import parse_fault
     from mjswarm.experiments.runs import run_exploration
+    from mjswarm.experiments.awareness import truth
+    from mjswarm.outputs.exploration_recording import ExplorationRecording
     from mjswarm.outputs.recording import Recorder
     from mjswarm.outputs.video import Video, area, filming
 
@@ -74,6 +76,7 @@ def run_embodied(args) -> dict:
             recorder = outputs.enter_context(Recorder(
                 temp, spec, args.robots, radio=args.radio_range is not None,
                 video=args.video is not None))
+        recording = None if recorder is None else ExplorationRecording(recorder, spec, truth)
         if args.video:
             video = Video(outputs.enter_context(atomic_output(args.video, "video")),
                           area(spec.vertices.values()), check_video(args),
@@ -83,7 +86,7 @@ def run_embodied(args) -> dict:
                 result = run_exploration(
                     spec, args.robots, args.strategy, world="embodied", seed=args.seed,
                     max_time=args.max_time, radio_range_m=args.radio_range,
-                    connectivity=args.connectivity, config=config, recorder=recorder,
+                    connectivity=args.connectivity, config=config, recorder=recording,
                     functions=[video] if video is not None else [], progress=True)
             except RunInterrupted as stop:  # the outputs keep their partial contents
                 stop.result = _embodied_dict(stop.result, args)

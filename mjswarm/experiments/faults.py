@@ -25,13 +25,10 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
-from algorithms.exploration import Beacon
+from mjswarm.arena import ArenaSpec
 from mjswarm.errors import MjswarmError
-
-if TYPE_CHECKING:  # the loop functions call faults; faults act on them
-    from mjswarm.experiments.exploration import EmbodiedExploration
+from mjswarm.worlds.loop import Loop, LoopFunctions
 
 FORMS = ("robot:I@T", "beacon:V@T", "radio-blackout@T1-T2")
 _NUMBER = r"(\d+(?:\.\d*)?|\.\d+)"
@@ -39,17 +36,18 @@ _NUMBER = r"(\d+(?:\.\d*)?|\.\d+)"
 
 @dataclass(frozen=True)
 class RobotFailure:
-    """Robot ``robot`` (0-based) fails at ``at_s``."""
+    """Robot ``robot`` (0-based) fails at ``at_s``: the world switches it off."""
 
     robot: int
     at_s: float
 
-    def check(self, run: EmbodiedExploration) -> None:
-        if not 0 <= self.robot < len(run.minds):
-            raise MjswarmError(f"fault {self}: there are robots 1..{len(run.minds)}")
+    def check(self, n_robots: int, spec: ArenaSpec, radio: bool) -> None:
+        if not 0 <= self.robot < n_robots:
+            raise MjswarmError(f"fault {self}: there are robots 1..{n_robots}")
 
-    def apply(self, run: EmbodiedExploration) -> None:
-        run.fail(self.robot, f"failed (fault {self})")
+    def apply(self, world) -> list:
+        world.power_off(self.robot, f"failed (fault {self})")
+        return []
 
     def __str__(self) -> str:
         return f"robot:{self.robot + 1}@{self.at_s:g}"
@@ -62,12 +60,13 @@ class BeaconWipe:
     vertex: str
     at_s: float
 
-    def check(self, run: EmbodiedExploration) -> None:
-        if self.vertex not in run.spec.vertices:
-            raise MjswarmError(f"fault {self}: {self.vertex!r} is not a vertex of {run.spec.name}")
+    def check(self, n_robots: int, spec: ArenaSpec, radio: bool) -> None:
+        if self.vertex not in spec.vertices:
+            raise MjswarmError(f"fault {self}: {self.vertex!r} is not a vertex of {spec.name}")
 
-    def apply(self, run: EmbodiedExploration) -> None:
-        run.beacons[self.vertex] = Beacon()
+    def apply(self, world) -> list:
+        world.wipe_beacon(self.vertex)
+        return []
 
     def __str__(self) -> str:
         return f"beacon:{self.vertex}@{self.at_s:g}"
@@ -80,16 +79,15 @@ class RadioBlackout:
     at_s: float
     end_s: float
 
-    def check(self, run: EmbodiedExploration) -> None:
+    def check(self, n_robots: int, spec: ArenaSpec, radio: bool) -> None:
         if self.end_s <= self.at_s:
             raise MjswarmError(f"fault {self}: the blackout must end after it starts")
-        if run.config.radio_range_m is None:
+        if not radio:
             raise MjswarmError(f"fault {self} needs robots with radios (--radio-range)")
 
-    def apply(self, run: EmbodiedExploration) -> None:
-        run.world.radio.blackout = True
-        run.pending_faults.append(_BlackoutEnd(self.end_s))
-        run.pending_faults.sort(key=lambda f: f.at_s)
+    def apply(self, world) -> list:
+        world.radio.blackout = True
+        return [_BlackoutEnd(self.end_s)]
 
     def __str__(self) -> str:
         return f"radio-blackout@{self.at_s:g}-{self.end_s:g}"
@@ -101,8 +99,9 @@ class _BlackoutEnd:
 
     at_s: float
 
-    def apply(self, run: EmbodiedExploration) -> None:
-        run.world.radio.blackout = False
+    def apply(self, world) -> list:
+        world.radio.blackout = False
+        return []
 
     def __str__(self) -> str:
         return f"radio back at {self.at_s:g}"
@@ -120,16 +119,16 @@ _PATTERNS = (
 )
 
 
-def check_fault(fault: Fault, run: EmbodiedExploration) -> None:
-    """Refuse, in one line, a fault that does not fit ``run``: one that can never fire
-    (its time is past the run's ``max_sim_time_s``) or whose target is not there. A fault
-    whose time the run does not reach because the run ended earlier is reported as not
-    fired in the result instead."""
-    end_s = run.config.max_sim_time_s
+def check_fault(fault: Fault, n_robots: int, spec: ArenaSpec, radio: bool,
+                end_s: float) -> None:
+    """Refuse, in one line, a fault that does not fit a run of ``n_robots`` on ``spec``
+    (``radio``: robots carry radios) ending at ``end_s``: one that can never fire or
+    whose target is not there. A fault whose time the run does not reach because the
+    run ended earlier is reported as not fired in the result instead."""
     if fault.at_s >= end_s:
         raise MjswarmError(f"fault {fault} can never fire: the run ends at {end_s:g} s "
                            "(--max-time)")
-    fault.check(run)
+    fault.check(n_robots, spec, radio)
 
 
 def is_user_fault(fault) -> bool:
@@ -148,3 +147,29 @@ def parse_fault(text: str) -> Fault:
             return fault
     raise MjswarmError(f"bad fault '{text}': expected one of {', '.join(FORMS)} "
                        "(times in simulated seconds)")
+
+
+class Faults(LoopFunctions):
+    """Injects ``faults`` into ``world`` at the control tick nearest to each one's time;
+    a fault acts through the world only (a robot switched off, a beacon wiped, the radio
+    blacked out), never inside a controller. :meth:`log` says which fired, and when."""
+
+    def __init__(self, world, faults) -> None:
+        self.world = world
+        self.pending = sorted(faults, key=lambda f: f.at_s)
+        self.fired: list[dict] = []
+
+    def before_step(self, loop: Loop) -> None:
+        world = self.world
+        now = world.time_s + world.control_dt_s / 2.0
+        while self.pending and self.pending[0].at_s <= now:
+            fault = self.pending.pop(0)
+            self.pending = sorted([*self.pending, *fault.apply(world)], key=lambda f: f.at_s)
+            self.fired.append({"fault": str(fault), "fired": True,
+                               "at_s": round(world.time_s, 2)})
+            loop.event(f"fault: {fault}")
+
+    def log(self) -> list[dict]:
+        """Every fault asked for: fired (when), or not fired."""
+        return [*self.fired, *({"fault": str(f), "fired": False, "at_s": None}
+                               for f in self.pending if is_user_fault(f))]

@@ -45,7 +45,8 @@ def run_exploration(spec: ArenaSpec, robots: int,
     :class:`~mjswarm.experiments.exploration.EmbodiedConfig` (its radio, constraint and
     time limit are set from the arguments above when given); ``functions``: more loop
     functions (a video; not in the radio graph world, which is not on the loop yet);
-    ``recorder``: an embodied run's rerun recorder; ``progress``: a progress display
+    ``recorder``: a loop function that records an embodied run
+    (:class:`~mjswarm.outputs.exploration_recording.ExplorationRecording`); ``progress``: a progress display
     (embodied world).
     """
     if world not in WORLDS:

@@ -51,8 +51,28 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
+from algorithms.exploration.entry import (
+    EntryDenied,
+    EntryGranted,
+    EntryRequest,
+    Halted,
+    LeftVertex,
+    TurnedBack,
+    VertexClear,
+    Withdraw,
+)
+from algorithms.exploration.events import VertexCalled
 from mjswarm.arena import ArenaSpec
-from mjswarm.arena.geometry import vertex_fans
+from mjswarm.arena.geometry import VERTEX_CLEAR_RADIUS_M, vertex_fans
+from mjswarm.worlds.loop import Loop, LoopFunctions
+
+#: A robot is on a vertex when within this distance of its centre (m).
+ON_VERTEX_M = 0.05
+#: The stations map a robot's departure angle to an edge only within this (rad): half
+#: the 45 degree minimum angle between edges at a vertex.
+DEPARTURE_TOLERANCE_RAD = math.radians(22.5)
 
 
 @dataclass(frozen=True)
@@ -142,3 +162,185 @@ class VertexStations:
             if holder in chain:
                 return []  # a cycle that does not pass through ``robot``
             chain.append(holder)
+
+
+class NearestVertex:
+    """Which vertex each robot of ``sim`` is nearest to, and how far (m): what the
+    stations see. Worked out once per world state, for every robot at once."""
+
+    def __init__(self, sim, spec: ArenaSpec) -> None:
+        self.sim = sim
+        self._xy = np.array(list(spec.vertices.values()))
+        self._ids = list(spec.vertices)
+        self._version = -1
+        self._nearest = self._distance = None
+
+    def __call__(self, i: int) -> tuple[str, float]:
+        sim = self.sim
+        if self._version != sim.state_version:
+            xy = sim.poses()[:, :2]
+            d = np.hypot(xy[:, None, 0] - self._xy[None, :, 0],
+                         xy[:, None, 1] - self._xy[None, :, 1])
+            self._nearest = d.argmin(axis=1)
+            self._distance = d[np.arange(len(xy)), self._nearest]
+            self._version = sim.state_version
+        return self._ids[self._nearest[i]], float(self._distance[i])
+
+
+class StationService(LoopFunctions):
+    """The vertex stations as a loop function: the beacon service (which vertex's beacon a
+    robot may read now) and the entry protocol (:mod:`algorithms.exploration.entry`)
+    over ``uplink``. ``avoid``: vertex entry is on (else a robot's vertex is the one its
+    decision leads to, and any robot on a centre reads its beacon)."""
+
+    def __init__(self, spec: ArenaSpec, world, uplink, nearest: NearestVertex,
+                 avoid: bool) -> None:
+        self.spec, self.world, self.uplink = spec, world, uplink
+        self.nearest, self.avoid = nearest, avoid
+        self.stations = VertexStations(spec)
+        k = world.n
+        #: each robot's vertex: the one it stands on or was granted; the one it is leaving
+        self.target: list[str | None] = [None] * k
+        self.leaving: list[str | None] = [None] * k
+        #: the vertex each robot last asked to leave (where a walk back takes it), and
+        #: the angle it asked for
+        self.came_from: list[str | None] = [None] * k
+        self.asked: list[float | None] = [None] * k
+        #: robots granted a vertex whose previous holder has not yet left it
+        self.awaiting_clear: set[int] = set()
+        self.loop: Loop | None = None
+        world.beacon_at = self.beacon_at
+        world.power_listeners.append(self._switched_off)
+
+    def initialize(self, loop: Loop) -> None:
+        self.loop = loop
+
+    def _switched_off(self, i: int, reason: str) -> None:
+        if self.world.present[i]:  # one still in the depot holds nothing
+            self._release(i)
+
+    # ------------------------------------------------------------------ beacons
+    def beacon_at(self, i: int) -> str | None:
+        """The vertex whose beacon robot ``i`` may read now: the one whose centre it
+        stands on, if the station there granted it that vertex (or launched it there), or
+        has granted it the next one and not yet seen it leave."""
+        vertex, distance = self.nearest(i)
+        if distance >= ON_VERTEX_M:
+            return None
+        if self.avoid and vertex != self.target[i] and vertex != self.leaving[i]:
+            return None
+        return vertex
+
+    # ------------------------------------------------------------------ hooks
+    def launched(self, i: int, vertex: str) -> None:
+        """Robot ``i`` was put on ``vertex``'s centre: it holds it."""
+        if self.avoid:
+            self.stations.occupy(i, vertex)
+        self.target[i] = vertex
+
+    def before_step(self, loop: Loop) -> None:
+        """The stations' mail, then their grants."""
+        for message in self.uplink.receive():
+            self._receive(message.sender, message.payload)
+        if not self.avoid:
+            return
+        granted = self.stations.grant()
+        for i, vertex in granted:  # a cycle's grants all take effect at once ...
+            self.leaving[i], self.target[i] = self.target[i], vertex
+        for i, vertex in granted:  # ... before anyone is told whether its vertex is clear
+            clear = not any(v == vertex for j, v in enumerate(self.leaving) if j != i)
+            if not clear:
+                self.awaiting_clear.add(i)
+            self.uplink.reply(i, EntryGranted(clear, self.asked[i]))
+            loop.event(f"R{i + 1} granted {vertex}", i)
+
+    def after_step(self, loop: Loop) -> None:
+        """Without vertex entry, a robot's vertex is the one its decision leads to."""
+        if self.avoid:
+            return
+        for i, event in loop.reports:
+            if type(event) is VertexCalled and event.action == "go":
+                vertex = self.nearest(i)[0]
+                self.target[i] = self.stations.edge_towards(vertex, event.angle_rad)[0]
+
+    # ------------------------------------------------------------------ protocol
+    def _receive(self, i: int, payload) -> None:
+        if isinstance(payload, EntryRequest):
+            self._request(i, payload)
+        elif isinstance(payload, TurnedBack):
+            self._turned_back(i, payload.from_lane)
+        elif isinstance(payload, Withdraw):
+            self._withdraw(i)
+        elif isinstance(payload, LeftVertex):
+            left, self.leaving[i] = self.leaving[i], None
+            self.stations.release(i, left)
+            self._tell_clear()
+        elif isinstance(payload, Halted):
+            self._release(i)
+
+    def _request(self, i: int, payload: EntryRequest) -> None:
+        vertex = self.target[i]
+        ahead, off = self.stations.edge_towards(vertex, payload.angle_rad)
+        if off > DEPARTURE_TOLERANCE_RAD:  # the denial names no vertex: robots know none
+            self.uplink.reply(i, EntryDenied(
+                f"its departure angle is {math.degrees(off):.0f} deg from every edge at "
+                "its vertex"))
+            return
+        self.came_from[i], self.asked[i] = vertex, payload.angle_rad
+        if payload.part_way:  # a relay's last leg: onto the lane, not into ``ahead``
+            self.leaving[i], self.target[i] = vertex, None
+            self.uplink.reply(i, EntryGranted(False, payload.angle_rad))
+            return
+        self.stations.request(i, vertex, ahead, self.world.time_s)
+
+    def _withdraw(self, i: int) -> None:
+        """Robot ``i``, still on its vertex centre, drops its request or gives its grant
+        back (:mod:`algorithms.exploration.entry`, step 5). If its vertex went to another
+        robot in a swap, that robot still waits until this one has left the area."""
+        self.stations.withdraw(i)
+        here = self.leaving[i]
+        if here is None:
+            return  # not granted yet
+        self.stations.release(i, self.target[i])
+        self.awaiting_clear.discard(i)
+        self.target[i] = here
+        if self.stations.holder.get(here) == i:
+            self.leaving[i] = None
+        self._tell_clear()
+
+    def _turned_back(self, i: int, from_lane: bool) -> None:
+        """Robot ``i`` walks back along its edge (:mod:`algorithms.exploration.entry`, step
+        5): short of its corridor it gets the vertex behind back at once, unless the
+        station gave it to another robot (a swap: no answer, and it goes on); else it asks
+        for it as from a centre, and the grant tells it when it may turn, or enter."""
+        back = self.came_from[i]
+        if not from_lane and self.leaving[i] == back and self.stations.holder.get(back) != i:
+            return
+        self.awaiting_clear.discard(i)
+        self.stations.release(i, self.target[i])
+        if self.leaving[i] == back:  # it had not left that area: it is its own again
+            self.leaving[i], self.target[i] = None, back
+            self.uplink.reply(i, EntryGranted(clear=True))
+        else:  # from its lane, or its corridor: as a request from a centre
+            self.target[i], self.asked[i] = None, None  # the grant answers no EntryRequest
+            self.stations.request(i, None, back, self.world.time_s)
+        self._tell_clear()
+
+    def _release(self, i: int) -> None:
+        """Robot ``i`` stopped for good (or was switched off): its holds go; a station
+        whose vertex area the body still occupies keeps the vertex closed (it sees the
+        body, as it sees who stands on its centre)."""
+        self.stations.release_all(i)
+        vertex, distance = self.nearest(i)
+        if distance < VERTEX_CLEAR_RADIUS_M:
+            self.stations.occupy(i, vertex)
+        self.leaving[i] = None
+        self.awaiting_clear.discard(i)
+        self._tell_clear()
+
+    def _tell_clear(self) -> None:
+        """Tell the robots waiting for a vertex whose previous holder has now left it."""
+        for j in sorted(self.awaiting_clear):
+            if self.target[j] not in self.leaving:
+                self.awaiting_clear.discard(j)
+                self.uplink.reply(j, VertexClear())

@@ -15,7 +15,9 @@ store, and :class:`~algorithms.robot.VertexSense` the exact incidence angles and
 angle of the edge the robot arrived by. The decision is a command: ``edge_rad`` leaves
 along that edge (the robot arrives at the far end after the edge's duration), no edge
 idles (the robot is called again one time unit later). The world owns one
-:class:`~algorithms.exploration.base.Beacon` per vertex and never looks inside it.
+:class:`~algorithms.exploration.base.Beacon` per vertex and never looks inside it; a
+robot gets a :class:`~algorithms.exploration.base.BeaconHandle` on it that works until
+the world steps (afterwards any use raises).
 Robots run :class:`~algorithms.exploration.graph_explorer.GraphExplorer` controllers or
 any other :class:`~algorithms.robot.Controller`; the experiment and its metrics are loop
 functions (:mod:`mjswarm.experiments.graph_exploration`).
@@ -31,7 +33,7 @@ import networkx as nx
 import numpy as np
 
 from algorithms.exploration import Beacon
-from algorithms.exploration.base import angle_gap, normalize_angle
+from algorithms.exploration.base import BeaconHandle, angle_gap, normalize_angle
 from algorithms.robot import NOTHING, Command, Observation, VertexSense
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.loop import World
@@ -110,6 +112,7 @@ class GraphWorld(World):
         self._events = [(0, -i) for i in range(n_robots)]
         heapq.heapify(self._events)
         self._unit = self.edge_time == "unit"
+        self._handles: list[BeaconHandle] = []  # handed out in this tick
         self._advance()
 
     def _advance(self) -> None:
@@ -137,8 +140,10 @@ class GraphWorld(World):
 
     def observe(self, i: int) -> Observation:
         v = self.at[i]  # positional: a call per decision, twice as fast as by keyword
+        handle = BeaconHandle(self.beacons[v])
+        self._handles.append(handle)
         return Observation(i, self._now, None, None, None, None, None, None, NOTHING, NOTHING,
-                           (), frozenset(), self.beacons[v],
+                           (), frozenset(), handle,
                            VertexSense(self.angles[v], self._arrived_by[i]))
 
     def act(self, i: int, command: Command) -> None:
@@ -159,6 +164,9 @@ class GraphWorld(World):
         heapq.heappush(self._events, (done_at, -i))
 
     def step(self) -> None:
+        for handle in self._handles:  # the tick is over: its handles no longer work
+            handle.expire()
+        self._handles = []
         self._advance()
 
     def true_poses(self) -> np.ndarray:

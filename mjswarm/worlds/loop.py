@@ -16,6 +16,7 @@ between phases, never between two robots::
     for f in functions: f.before_step(loop)
     robots = world.active()                      # robots on the floor, in id order
     for i in robots entering the floor: controllers[i].reset()
+    robots = world.nodes + robots                # fixed radio nodes (a base) first
     observations = [world.observe(i) for i in robots]              # sense all
     for i, o in ...: controllers[i].perceive(o)                    # (bookkeeping)
     commands = [controllers[i].step(o) for i, o in ...]            # control all
@@ -70,6 +71,10 @@ class World(ABC):
     #: robots off the floor whose radio is on the air at a fixed point, by id: position
     #: (m) (a robot docked at a base station, rule 1 of :mod:`algorithms.exploration.tether`)
     docked: Mapping = NOTHING
+    #: radio nodes off the floor that the loop steps every tick before the robots (a base
+    #: station, a docked robot): their controllers observe and act as robots do, and are
+    #: never reset by the loop (they never enter the floor)
+    nodes: Sequence = ()
 
     @property
     @abstractmethod
@@ -291,6 +296,9 @@ class Loop:
         if self.halted:
             robots = [i for i in robots if i not in self.halted]
         self._enter(robots)
+        nodes = world.nodes
+        if nodes:
+            robots = [*nodes, *robots]
         observe, act = world.observe, world.act
         observations = [observe(i) for i in robots]
         if self._perceive:

@@ -10,6 +10,16 @@ links need line of sight both ways (:func:`mjswarm.core.radio.sight_blocker`).
 
 Every robot is on the floor unless a loop function says otherwise (``present``: robots
 waiting in a depot off the arena are neither stepped nor on the air).
+
+**Beacons** (``beacons``, a store keyed by vertex) belong to the world: loop functions
+decide which vertex's beacon a robot may read now (``beacon_at``), and the robot gets a
+:class:`~algorithms.exploration.base.BeaconHandle` that works until the world steps.
+A fault wipes one with :meth:`SparkWorld.wipe_beacon`. **Power**: a robot switched off
+(:meth:`SparkWorld.power_off`, a fault) stands where it is, off the air, and is no
+longer stepped; loop functions that must know (the stations see its body) listen
+through ``power_listeners``. **Fixed radio nodes** (a base station at ``fixed``, robots
+``docked`` at it) are stepped by the loop before the robots (``nodes``): they observe
+their radio only and answer with messages.
 """
 
 from __future__ import annotations
@@ -20,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from algorithms.exploration.base import BeaconHandle
 from algorithms.robot import NOTHING, Command, Detection, Observation
 from mjswarm.core.bearing import BearingSensor
 from mjswarm.worlds.loop import World
@@ -31,8 +42,10 @@ class SparkWorld(World):
         sim: the MuJoCo world.
         bearing: the robots' bearing sensor (None: robots have none).
         present: which robots are on the floor (default all).
-        beacon_at: ``beacon_at(i)``, the beacon robot ``i`` can read now (the station of
-            the vertex whose centre it stands on), else None; set by loop functions.
+        beacon_at: ``beacon_at(i)``, the vertex (a key of ``beacons``) whose beacon robot
+            ``i`` can read now (the station of the vertex whose centre it stands on), else
+            None; set by loop functions.
+        beacons: the beacon store, by vertex (None: no beacons).
         ranging: robots carry a radio-ranging sensor (as ultra-wideband radios do): the
             range and bearing of every radio neighbour, fixed nodes included, noise-free,
             as ``Observation.detections``.
@@ -40,13 +53,19 @@ class SparkWorld(World):
 
     def __init__(self, sim: Simulation, bearing: BearingSensor | None = None,
                  present: np.ndarray | None = None,
-                 beacon_at: Callable[[int], Any] | None = None, ranging: bool = False) -> None:
+                 beacon_at: Callable[[int], Any] | None = None, ranging: bool = False,
+                 beacons: dict | None = None) -> None:
         self.sim = sim
         self.n = sim.n
         self.present = np.ones(self.n, bool) if present is None else np.array(present, bool)
         self.control_dt_s = sim.control_dt_s
         self.bearing = bearing
         self.beacon_at = beacon_at
+        self.beacons = beacons
+        self.powered = np.ones(self.n, bool)
+        #: called with ``(robot, reason)`` when a robot is switched off
+        self.power_listeners: list[Callable[[int, str], None]] = []
+        self._handles: list[BeaconHandle] = []  # handed out this tick
         self.uplinks = {}
         self.fixed = {}
         self.docked = {}
@@ -68,7 +87,22 @@ class SparkWorld(World):
     def contact_events(self) -> list[tuple[float, int, int]]:
         return self.sim.collisions.events
 
-    def observe(self, i: int) -> Observation:
+    def active(self) -> list[int]:
+        """The robots on the floor and switched on."""
+        return np.flatnonzero(self.present & self.powered).tolist()
+
+    @property
+    def nodes(self) -> list:
+        """The fixed radio nodes the loop steps before the robots: the base station(s),
+        then the docked robots that are switched on."""
+        if not self.fixed and not self.docked:
+            return []
+        return [*self.fixed, *(i for i in self.docked if self.powered[i])]
+
+    def observe(self, i) -> Observation:
+        if i in self.fixed or i in self.docked:
+            inbox, neighbors = self._inbox(i)
+            return Observation(i, self.sim.time_s, inbox=inbox, neighbors=neighbors)
         if self._version != self.sim.state_version:  # one read of every sensor per state
             r = self.sim.readings()
             self._columns = (r["line"].tolist(), r["ir"].tolist(), r["encoder"].tolist(),
@@ -82,7 +116,29 @@ class SparkWorld(World):
             i, self._now_s, line[i], ir[i], encoder[i], wheel_speed[i], battery[i], None,
             NOTHING if self._bearings is None else self._bearings[i],
             self._ranges(i, neighbors) if self.ranging else NOTHING, inbox,
-            neighbors, None if self.beacon_at is None else self.beacon_at(i))
+            neighbors, self._beacon(i))
+
+    def _beacon(self, i: int) -> BeaconHandle | None:
+        """A handle on the beacon robot ``i`` may read now, good until the world steps."""
+        vertex = None if self.beacon_at is None else self.beacon_at(i)
+        if vertex is None:
+            return None
+        handle = BeaconHandle(self.beacons[vertex])
+        self._handles.append(handle)
+        return handle
+
+    def wipe_beacon(self, vertex) -> None:
+        """The beacon at ``vertex`` loses its contents and id (a fault)."""
+        self.beacons[vertex] = type(self.beacons[vertex])()
+
+    def power_off(self, i: int, reason: str) -> None:
+        """Switch robot ``i`` off (a fault): it stands where it is (its body stays), off
+        the air, and is never stepped again; ``power_listeners`` hear of it."""
+        self.powered[i] = False
+        self._v[i] = self._w[i] = 0.0
+        self.set_on_air(i, False)
+        for listener in self.power_listeners:
+            listener(i, reason)
 
     def _ranges(self, i: int, neighbors) -> dict:
         """Robot ``i``'s ranging of its radio neighbours: range (m) and bearing (rad)."""
@@ -104,12 +160,19 @@ class SparkWorld(World):
         recordings; empty without a bearing sensor)."""
         return self._bearings if self._bearings is not None else [{} for _ in range(self.n)]
 
-    def act(self, i: int, command: Command) -> None:
+    def act(self, i, command: Command) -> None:
+        if i in self.fixed or i in self.docked:
+            self._send(i, command.messages)  # a fixed node: its radio only
+            return
         self._v[i], self._w[i] = command.v_m_s, command.omega_rad_s
         if command.messages:
             self._send(i, command.messages)
 
     def step(self) -> None:
+        if self._handles:  # the tick is over: its beacon handles no longer work
+            for handle in self._handles:
+                handle.expire()
+            self._handles = []
         self.sim.set_velocity(np.array(self._v), np.array(self._w))
         self.sim.step()
         self._radio_step()

@@ -1,0 +1,173 @@
+"""What an embodied exploration measures, from what its robots report (a loop function).
+
+The robots' controllers report through typed events (:mod:`algorithms.exploration.
+events`, in ``Loop.reports``) and :meth:`~algorithms.robot.Controller.telemetry`; this
+loop function never reads a controller's attributes. Ground truth (true poses, the
+nearest vertex) is the world's. It keeps each robot's path of vertices, who declared
+completion where and when, who stopped and why, the collision rule's activations, relay
+trips, infeasibility verdicts and the largest odometry heading error, and says when the
+run is over (:meth:`ExplorationMetrics.should_stop`).
+
+Events are accounted at the state the robots observed in the tick (as when they decided):
+the time and true poses taken at the start of the tick.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+from algorithms.exploration.events import (
+    Declared,
+    Infeasible,
+    RelayTrip,
+    SpeedChanged,
+    SpeedRuleFired,
+    Stopped,
+    VertexCalled,
+)
+from mjswarm.worlds.loop import Loop, LoopFunctions
+
+
+class Roster:
+    """What the loop functions of one run share about the team, learnt from reports and
+    from the world (never from controllers): who is done (stopped, declared, switched off
+    or docked) and when a robot last reached a vertex (or was launched)."""
+
+    def __init__(self, docked=()) -> None:
+        self.docked = frozenset(docked)
+        self.finished: set[int] = set()  # stopped, declared or switched off
+        self.failed: set[int] = set()
+        self.last_progress_s = 0.0
+
+    def is_done(self, i: int) -> bool:
+        return i in self.finished or i in self.docked
+
+    @property
+    def count_done(self) -> int:
+        return len(self.finished | self.docked)
+
+
+class ExplorationMetrics(LoopFunctions):
+    """Args:
+        world: the run's world (its true poses and clock).
+        roster: the shared :class:`Roster`.
+        nearest: ``nearest(i) -> (vertex, distance m)``, where robot ``i`` stands now.
+        root: where every path starts.
+        stall_timeout_s: end the run when no robot reached a vertex for this long (None:
+            never; the tethered robots judge stalls themselves).
+        infeasible_reason: ``infeasible_reason(paths)``, the verdict's text.
+    """
+
+    def __init__(self, world, roster: Roster, nearest: Callable, root: str,
+                 stall_timeout_s: float | None, infeasible_reason: Callable) -> None:
+        self.world, self.roster, self.nearest = world, roster, nearest
+        self.stall_timeout_s = stall_timeout_s
+        self.infeasible_reason = infeasible_reason
+        k = world.n
+        self.paths = [[root] for _ in range(k)]
+        self.beacon_vertex: dict[str, str] = {}
+        self.declared: tuple[float, int, str] | None = None
+        self.declared_map: tuple = ()
+        self.stopped: list[dict] = []
+        self.speed_changes = 0
+        self.relay_trips = 0
+        self.infeasible = False
+        self.heading_error_rad = 0.0
+        self.ended_because = "max time"
+        self._observed = (0.0, None)  # (time s, true poses) at the start of the tick
+        self._loop: Loop | None = None
+        world.power_listeners.append(self._switched_off)
+
+    def _switched_off(self, i: int, reason: str) -> None:
+        """A robot switched off (a fault) stops, unless it had stopped or declared."""
+        if i not in self.roster.finished:
+            self._stop(i, reason, self.world.time_s)
+        self.roster.finished.add(i)
+        self.roster.failed.add(i)
+
+    def before_step(self, loop: Loop) -> None:
+        self._observed = (self.world.time_s, self.world.true_poses().copy())
+
+    def after_step(self, loop: Loop) -> None:
+        now, poses = self._observed
+        called = set()
+        for i, event in loop.reports:
+            kind = type(event)
+            if kind is VertexCalled:
+                self._vertex_called(loop, i, event, now)
+                called.add(i)
+            elif kind is SpeedRuleFired:
+                self.speed_changes += event.count
+            elif kind is SpeedChanged:
+                loop.event(f"R{i + 1} speed {event.old_m_s:.3f} -> {event.new_m_s:.3f} m/s", i)
+            elif kind is Stopped:
+                if i not in self.roster.finished:
+                    self._stop(i, event.reason, now)
+                self.roster.finished.add(i)
+            elif kind is Declared:
+                self.declared_map = event.map_edges
+            elif kind is RelayTrip:
+                self.relay_trips += 1
+            elif kind is Infeasible:
+                self.infeasible = True
+        controllers = loop.controllers
+        for i in loop.stepped:
+            if type(i) is int:  # a robot on the floor, not a fixed radio node
+                state = controllers[i].telemetry()
+                if i in called or state.get("on_edge"):
+                    self._heading(state.get("heading_rad"), poses[i, 2])
+
+    def _vertex_called(self, loop: Loop, i: int, call: VertexCalled, now: float) -> None:
+        vertex = self.nearest(i)[0]  # where it stands (its beacon was served)
+        if call.arrived:
+            self.paths[i].append(vertex)
+            self.roster.last_progress_s = now
+            loop.event(f"R{i + 1} at {vertex}", i)
+        if call.beacon_id is not None:
+            self.beacon_vertex.setdefault(call.beacon_id, vertex)
+        if call.action == "done":
+            self.declared = (now, i, vertex)
+            self.roster.finished.add(i)
+            loop.event(f"R{i + 1} declares completion at {vertex}", i)
+            loop.event(f"R{i + 1} declared completion at {vertex}")
+
+    def _heading(self, heading: float | None, true_yaw: float) -> None:
+        """``heading_error_deg``: odometry against the truth, on lanes and at vertex calls
+        (mid-scan the odometry over-reads rotation until the scan's own calibration
+        corrects it)."""
+        if heading is not None:
+            error = abs(math.remainder(heading - true_yaw, 2 * math.pi))
+            self.heading_error_rad = max(self.heading_error_rad, error)
+
+    def _stop(self, i: int, reason: str, now: float) -> None:
+        self.stopped.append({"robot": i + 1, "reason": reason, "at_s": round(now, 2)})
+        if self._loop is not None:
+            self._loop.event(f"R{i + 1} stopped: {reason}", i)
+
+    def initialize(self, loop: Loop) -> None:
+        self._loop = loop
+
+    def should_stop(self, loop: Loop) -> bool:
+        """Whether the run is over (and why, in ``ended_because``)."""
+        if self.declared is not None:
+            self.ended_because = "completed"
+        elif self.infeasible:
+            self.ended_because = self.infeasible_reason(self.paths)
+        elif self.roster.count_done >= self.world.n:
+            self.ended_because = "all robots stopped"
+        elif (self.stall_timeout_s is not None
+              and self.world.time_s - self.roster.last_progress_s > self.stall_timeout_s):
+            self.ended_because = "stalled"
+        else:
+            return False
+        return True
+
+    @property
+    def traversals(self) -> int:
+        return sum(len(p) - 1 for p in self.paths)
+
+    @property
+    def makespan(self) -> int | None:
+        """The most edges any robot had traversed at completion (None: not completed)."""
+        return None if self.declared is None else max(len(p) - 1 for p in self.paths)

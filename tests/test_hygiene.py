@@ -1,0 +1,156 @@
+"""Hygiene that the types enforce (issue 28, item 4): nothing a robot observes or hears
+reaches the world's ground truth. Every Observation handed out and every Message
+delivered in a short run of each experiment is walked (attributes and containers, to a
+bounded depth) and must not reference a World, a Simulation, a beacon store (a dict of
+beacons), the Radio, MuJoCo's model or data, or a robot's controller."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from algorithms.exploration.base import Beacon, BeaconHandle, ExpiredBeacon
+from algorithms.robot import Controller, Observation
+from mjswarm.arena import load_arena
+from mjswarm.core.radio import Radio
+from mjswarm.core.simulation import Simulation
+from mjswarm.worlds.loop import Loop, World
+
+FORBIDDEN = (World, Simulation, Radio, Controller, mujoco.MjModel, mujoco.MjData)
+MAX_DEPTH, MAX_NODES = 8, 20000
+
+
+def offences(root) -> list[str]:
+    """What in ``root``'s object graph is forbidden (a path for each)."""
+    found, seen, stack, nodes = [], set(), [(root, "observation", 0)], 0
+    while stack and nodes < MAX_NODES:
+        obj, path, depth = stack.pop()
+        if id(obj) in seen or depth > MAX_DEPTH:
+            continue
+        seen.add(id(obj))
+        nodes += 1
+        if isinstance(obj, FORBIDDEN):
+            found.append(f"{path}: {type(obj).__name__}")
+            continue
+        if obj is None or isinstance(obj, (str, bytes, int, float, complex, np.ndarray)):
+            continue
+        if isinstance(obj, dict):
+            if obj and all(isinstance(v, Beacon) for v in obj.values()):
+                found.append(f"{path}: a beacon store")
+            children = [*((k, f"{path}[key]") for k in obj),
+                        *((v, f"{path}[{k!r}]") for k, v in obj.items())]
+        elif isinstance(obj, (tuple, list, set, frozenset)):
+            children = [(v, f"{path}[{i}]") for i, v in enumerate(obj)]
+        elif hasattr(obj, "items") and callable(obj.items):  # a read-only mapping
+            children = [(v, f"{path}[{k!r}]") for k, v in obj.items()]
+        else:
+            names = list(getattr(obj, "__dict__", {}))
+            for cls in type(obj).__mro__:
+                names += [s for s in getattr(cls, "__slots__", ()) if isinstance(s, str)]
+            children = [(getattr(obj, n), f"{path}.{n}") for n in names if hasattr(obj, n)]
+        stack += [(c, p, depth + 1) for c, p in children]
+    return found
+
+
+@pytest.fixture
+def watched(monkeypatch):
+    """Every observation of every loop run in the test is walked; the offences found."""
+    found: list[str] = []
+    counted = {"observations": 0, "messages": 0}
+    step = Loop.step
+
+    def watching_step(self):
+        world = self.world
+        if "observe" not in vars(world):
+            observe = world.observe
+
+            def checked(i):
+                o = observe(i)
+                counted["observations"] += 1
+                counted["messages"] += len(o.inbox)
+                found.extend(offences(o))
+                return o
+            world.observe = checked
+        step(self)
+
+    monkeypatch.setattr(Loop, "step", watching_step)
+    return found, counted
+
+
+def test_the_walker_finds_what_is_forbidden():
+    spec = load_arena("fig9")
+    bad = Observation(0, 0.0, beacon={v: Beacon() for v in spec.vertices})
+    assert [o.split(": ")[1] for o in offences(bad)] == ["a beacon store"]
+    assert offences(Observation(0, 0.0, inbox=((Controller,),))) == []
+
+
+def test_a_beacon_handle_works_only_in_its_tick():
+    beacon = Beacon()
+    handle = BeaconHandle(beacon)
+    handle.id, handle.data = "a1", {"x": 1}
+    assert (beacon.id, beacon.data) == ("a1", {"x": 1}) and handle.id == "a1"
+    handle.expire()
+    with pytest.raises(ExpiredBeacon):
+        handle.data
+    with pytest.raises(ExpiredBeacon):
+        handle.id = "b1"
+
+
+def _clean(watched, least_messages: int = 0):
+    found, counted = watched
+    assert counted["observations"] > 0 and counted["messages"] >= least_messages
+    assert found == [], found[:5]
+
+
+def test_embodied_exploration_hands_out_nothing_forbidden(watched):
+    from mjswarm.experiments.runs import run_exploration
+    from mjswarm.experiments.exploration import EmbodiedConfig
+
+    run_exploration(load_arena("fig9"), 2, world="embodied", seed=0, max_time=40.0,
+                    config=EmbodiedConfig(speed_m_s=0.15))
+    _clean(watched, 1)  # the stations' replies
+
+
+def test_connected_embodied_exploration_hands_out_nothing_forbidden(watched):
+    from mjswarm.experiments.runs import run_exploration
+    from mjswarm.experiments.exploration import EmbodiedConfig
+
+    run_exploration(load_arena("lattice:1x5:0.75"), 3, world="embodied", seed=0,
+                    max_time=80.0, radio_range_m=1.2, connectivity="connected",
+                    config=EmbodiedConfig(speed_m_s=0.1))
+    _clean(watched, 100)
+
+
+def test_graph_world_exploration_hands_out_nothing_forbidden(watched):
+    from mjswarm.experiments.runs import run_exploration
+
+    result = run_exploration(load_arena("fig9"), 3, world="graph", seed=0)
+    assert result.completed
+    _clean(watched)
+
+
+def test_old_beacon_handles_raise_in_the_graph_world():
+    """A controller that keeps its handle finds it dead at its next call."""
+    from mjswarm.worlds.graphworld import GraphWorld
+    from algorithms.robot import Command
+
+    class Hoarder(Controller):
+        def __init__(self):
+            self.kept, self.errors = [], 0
+
+        def step(self, o):
+            for old in self.kept:
+                try:
+                    old.id
+                except ExpiredBeacon:
+                    self.errors += 1
+            self.kept.append(o.beacon)
+            return Command(edge_rad=o.vertex.angles_rad[0])
+
+    spec = load_arena("fig9")
+    world = GraphWorld(spec.graph(), spec.root)
+    world.reset(1)
+    robot = Hoarder()
+    Loop(world, {0: robot}).run(max_ticks=3)
+    assert robot.errors == 0 + 1 + 2
