@@ -88,7 +88,7 @@ def _kind(t: type) -> tuple[int, tuple[str, ...]] | None:
     found = _KINDS.get(t, False)
     if found is not False:
         return found
-    if issubclass(t, (np.generic, enum.Enum)) or t in _HANDLES:
+    if issubclass(t, (np.generic, enum.Enum)):
         found = (_ATOM, ())
     elif issubclass(t, (tuple, frozenset)):
         found = (_SEQUENCE, ())
@@ -98,18 +98,6 @@ def _kind(t: type) -> tuple[int, tuple[str, ...]] | None:
         found = None
     _KINDS[t] = found
     return found
-
-
-def _handle_types() -> tuple[type, ...]:
-    """Objects that still travel as references while issue 28 moves them to opaque ids:
-    the exploration's :class:`~algorithms.exploration.base.Beacon` (a relay request names
-    the beacons of its route; receivers compare them by identity)."""
-    from algorithms.exploration.base import Beacon
-
-    return (Beacon,)
-
-
-_HANDLES = frozenset(_handle_types())
 
 
 def check_immutable(value: Any, what: str = "radio payload") -> None:
