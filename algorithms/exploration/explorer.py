@@ -277,7 +277,7 @@ class Explorer(Controller):
         speed = self.cruise_m_s
         if self.rule is not None:
             if nav.on_lane:  # the rule governs edge traversals
-                speed = self.rule.update(observation.bearings)
+                speed = self.rule.update(nav.lane_bearings(observation.bearings))
             else:
                 self.rule.forget_bearings()
             # a vertex area it gives up is one it never backs into (``_retrace``)
