@@ -36,20 +36,18 @@ def angle_error_deg(a: float, b: float) -> float:
     return abs(math.degrees(math.remainder(a - b, 2.0 * math.pi)))
 
 
-def run_walk(name: str, legs: int | None = None, **noise) -> dict:
-    """Drive the covering walk of arena ``name``; return what was measured per vertex
-    (``noise``: the simulation's noise and tier, e.g. ``wheel_slip``, ``physics``)."""
+def run_walk(name: str, legs: int | None = None) -> dict:
+    """Drive the covering walk of arena ``name``; return what was measured per vertex."""
     spec = load_arena(name)
     graph = spec.graph()
     walk = [spec.root] + [v for _, v in nx.eulerian_circuit(graph.to_directed(), source=spec.root)]
     walk = walk[: legs + 1] if legs else walk
     x, y = spec.vertices[spec.root]
-    sim = Simulation(arena_world_spec(spec, [Pose2D(x, y, 0.0)]), **noise)
+    sim = Simulation(arena_world_spec(spec, [Pose2D(x, y, 0.0)]))
     nav = Navigator(calibration(sim.geometry), conventions(sim.geometry), 0.0, SPEED_M_S)
     driver = Loop(SparkWorld(sim), {0: Navigating(nav)})
     nav.begin_at_vertex()
-    record = {"angle_errors": [], "arrival_errors": [], "edge_times": [], "spec": spec,
-              "navigator": nav}
+    record = {"angle_errors": [], "arrival_errors": [], "edge_times": [], "spec": spec}
 
     def run_until_at_vertex() -> float:
         on_edge_ticks = 0
@@ -152,15 +150,3 @@ def test_a_robot_turned_back_part_way_arrives_where_it_left_by_the_edge_it_left_
     assert angle_error_deg(nav.arrived_angle, first[0]) < ANGLE_TOLERANCE_DEG
     assert len(nav.edge_angles) == len(first)
     assert max(min(angle_error_deg(a, b) for a in nav.edge_angles) for b in first) < ANGLE_TOLERANCE_DEG
-
-
-def test_under_wheel_slip_the_spoke_calibrates_the_distance_scale():
-    """Wheel slip 0.05 (kinematic tier): the encoders over-read by 4 per cent on average
-    (0.8 of the slip); the spokes' known 90 mm, seen whole on every arrival, measure
-    that, and the last drive onto each centre is made on the calibrated scale. Uncalibrated
-    (the scale stays 1) the drive stopped 3-4 mm short and the spokes square to the
-    incoming one came out turned: this walk's worst angle was 7.2 degrees off (5.5 now;
-    a lone robot is never re-anchored, so its drift adds up over the walk)."""
-    record = run_walk("fig9", legs=6, wheel_slip=0.05, physics="kinematic", seed=1)
-    assert record["navigator"].odometry.distance_scale == pytest.approx(1.04, abs=0.01)
-    assert max(record["angle_errors"]) < 6.0

@@ -40,9 +40,6 @@ FULL_TURN_OVER = 0.095
 #: half a control tick's travel at the paper's 0.05 m/s (1 mm at 50 Hz), so a moving robot
 #: keeps one per tick and a standing one none.
 HEADING_SAMPLE_M = 0.0005
-#: A strip's direction is fitted to the centre sensor's track once it spans this (m)
-#: (:meth:`FollowLine.direction`): 7 mm across over 0.1 m is 4 degrees at worst.
-LANE_FIT_MIN_M = 0.1
 #: FollowSpoke holds its heading once the centre sensor alone has seen the spoke this far (m).
 SPOKE_ALIGN_M = 0.015
 
@@ -95,25 +92,19 @@ class Drive:
 class SeekLine:
     """Drive straight along ``heading`` until a line sensor sees a strip.
 
-    ``failed`` is set if none is found within ``max_distance_m``; else ``found_at_m`` is
-    the odometry distance where the strip was seen (``Percept.lag_ticks`` back) and
-    ``travelled_m`` how far the robot had driven to it.
+    ``failed`` is set if none is found within ``max_distance_m``.
     """
 
     heading: float
     speed: float
     max_distance_m: float
     failed: bool = False
-    found_at_m: float | None = None
-    travelled_m: float = 0.0
     _start: float | None = None
 
     def step(self, odo: Odometry, percept: Percept):
         if self._start is None:
             self._start = odo.distance_m
         if percept.any_line:
-            self.found_at_m = odo.distance_back(percept.lag_ticks)
-            self.travelled_m = self.found_at_m - self._start
             return None
         if odo.distance_m - self._start > self.max_distance_m:
             self.failed = True
@@ -178,7 +169,6 @@ class FollowLine:
 
     speed: float
     headings: list[float] = field(default_factory=list)
-    track: list[tuple[float, float]] = field(default_factory=list)
     ended_at_m: float | None = None
     _position: float = 0.0
     #: while the centre sensor tracks the strip: the side sensors on with it last tick
@@ -207,9 +197,6 @@ class FollowLine:
             self._position = side / 2.0 if centre else side
             if self._position == 0.0 and odo.distance_m - self._sampled_m >= HEADING_SAMPLE_M:
                 self.headings.append(odo.theta)
-                ahead = odo.cal.line_ahead_m
-                self.track.append((odo.x + ahead * math.cos(odo.theta),
-                                   odo.y + ahead * math.sin(odo.theta)))
                 self._sampled_m = odo.distance_m
         else:
             if self.ended_at_m is None:
@@ -219,31 +206,12 @@ class FollowLine:
         return self.speed, self.speed * LINE_CURVATURE * self._position
 
     def direction(self, fallback: float, last: int | None = 40) -> float:
-        """The strip's direction (rad, odometry frame) from the last ``last`` aligned
-        ticks (all if None), or ``fallback`` when there were none.
-
-        The line through the centre sensor's positions on those ticks (``track``, the
-        principal axis of the points), once they span ``LANE_FIT_MIN_M``: with the
-        centre sensor alone on the strip it is within 7 mm of the strip's centre line
-        (30 mm strip, sensors 22 mm apart), so over 0.3 m the line errs by a fraction
-        of a degree whatever the nose did. The nose swings a few degrees about the
-        strip, unevenly (each correction lasts as long as the line filter's lag), and
-        the mean heading of those ticks, used before (and still for shorter spans), was
-        off by up to 2-3 degrees under line noise and wheel slip (issue 27)."""
+        """Mean heading (rad) over the last ``last`` aligned ticks (all if None), or
+        ``fallback`` when there were none."""
         recent = self.headings[-last:] if last else self.headings
         if not recent:
             return fallback
-        mean = math.atan2(sum(math.sin(h) for h in recent), sum(math.cos(h) for h in recent))
-        points = self.track[-last:] if last else self.track
-        if math.dist(points[0], points[-1]) < LANE_FIT_MIN_M:
-            return mean
-        n = len(points)
-        mx, my = sum(p[0] for p in points) / n, sum(p[1] for p in points) / n
-        sxx = sum((p[0] - mx) ** 2 for p in points)
-        syy = sum((p[1] - my) ** 2 for p in points)
-        sxy = sum((p[0] - mx) * (p[1] - my) for p in points)
-        axis = 0.5 * math.atan2(2.0 * sxy, sxx - syy)
-        return axis if abs(wrap(axis - mean)) < math.pi / 2 else wrap(axis + math.pi)
+        return math.atan2(sum(math.sin(h) for h in recent), sum(math.cos(h) for h in recent))
 
 
 @dataclass

@@ -11,9 +11,8 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
 
 * **on an edge**: follow the lane; once the left wall has been seen for
   ``min_wall_run_m`` and then lost, the vertex is detected; the lane then ends;
-* **arriving**: shift right by ``lane_offset_m`` onto the centre line (turn 90 degrees,
-  drive, turn back), find the incoming spoke's outer end and follow the spoke to its
-  inner end (its known length calibrates the odometry's distance scale), drive
+* **arriving**: shift right by ``lane_offset_m`` onto the centre line (turn 60 degrees,
+  drive, turn back), find and follow the incoming spoke to its inner end, drive
   ``line_ahead_m + spoke_inner_radius_m`` to stand on the vertex centre. The approach
   runs at most at ``APPROACH_SPEED_M_S`` whatever the cruising speed, and once aligned
   with the spoke the robot holds its direction and watches only the centre sensor
@@ -35,11 +34,10 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
   leaving the two ends of one edge at once would then face each other on its centre line,
   where the collision rule stops both, seed 003 eq. (27) with ``beta = 0``.)
 
-Choices: the approach and departure shifts are open-loop odometry manoeuvres at 90 and
-60 degrees; the vertex-centre estimate has the accuracy of line following plus a 8 cm
-odometry drive on the calibrated distance scale (about a millimetre along the spoke, a
-few across it, which the incoming spoke's crossing corrects), which keeps scan angles
-within about a degree.
+Choices: the approach and departure shifts are open-loop odometry manoeuvres at 60
+degrees; the vertex-centre estimate has the accuracy of line following plus a 8 cm
+odometry drive (about a millimetre along the spoke, a few across it, which the incoming
+spoke's crossing corrects), which keeps scan angles within about a degree.
 """
 
 from __future__ import annotations
@@ -62,23 +60,7 @@ from algorithms.navigation.motions import (
 from algorithms.navigation.odometry import Odometry, RobotCalibration
 from algorithms.navigation.percept import LineFilter, Percept, WallWatch
 
-#: The departure's (and U-turn's) sidestep drives at this angle to the heading.
 SHIFT_ANGLE = math.radians(60.0)
-#: The arrival's sidestep onto the centre line drives square to the lane, so that it
-#: moves the robot no nearer the vertex: its line sensors land where its lane ended, at
-#: least the arena's lane end radius (0.16 m, ``mjswarm.arena.geometry``) from the
-#: vertex centre, outside the spoke's outer end (``spoke_radius_m``, 0.12 m), and the
-#: approach sees the whole spoke (at 60 degrees it moved 52 mm in and landed 12 mm
-#: inside it). The spoke's known length calibrates the odometry's distance scale.
-ARRIVAL_SHIFT_ANGLE = math.radians(90.0)
-#: A spoke calibrates the distance scale only if the approach drove at least this far (m)
-#: before seeing it (it began outside its outer end: 40 mm or more after the arrival's
-#: sidestep, none after a walk back to its outer end), and only a scale in this range
-#: (odometry metres per true metre): wheel slip over-reads by 0.8 of the slip on average
-#: (4 per cent at ``--wheel-slip 0.05``) and never under-reads; the ends are placed to
-#: a millimetre at the approach speed (1 to 2 per cent of the 90 mm spoke).
-SPOKE_SEEK_MIN_M = 0.01
-DISTANCE_SCALE_RANGE = (0.95, 1.15)
 #: Top speed (m/s) of the approach to a vertex centre (finding and following the spoke,
 #: the last drive): the spoke's end, which places the robot on the centre, is then seen
 #: within a millimetre of travel per control tick whatever the cruising speed (at 0.2 m/s
@@ -161,8 +143,6 @@ class Navigator:
         self._incoming: float | None = None
         self._scans = 0
         self._tracks: list[float] = []  # effective track estimates, one per scan (m)
-        self._distance_scales: list[float] = []  # one per spoke seen whole
-        self._spoke_seek: SeekLine | None = None  # how the approach found its spoke
         self._lane: FollowLine | None = None
         self._left: tuple[float, float, float] | None = None  # centre x, y and angle it left by
         #: x, y and heading (odometry) where its lane ended
@@ -317,15 +297,14 @@ class Navigator:
                 or self.state is NavigatorState.ARRIVING)
 
     # ---------------------------------------------------------------- plans
-    def _shift(self, heading: float, side: int, distance_m: float | None = None,
-               angle: float = SHIFT_ANGLE) -> list:
+    def _shift(self, heading: float, side: int, distance_m: float | None = None) -> list:
         """Sidestep ``distance_m`` (default ``lane_offset_m``) to the left (side=+1) or
-        right (-1) of ``heading``, driving at ``angle`` (rad) to it."""
-        diagonal = heading + side * angle
+        right (-1) of ``heading``."""
+        diagonal = heading + side * SHIFT_ANGLE
         across = self.conv.lane_offset_m if distance_m is None else distance_m
         return [
             (Turn(diagonal, self.turn_rate), None),
-            (Drive(across / math.sin(angle), diagonal, self.speed), None),
+            (Drive(across / math.sin(SHIFT_ANGLE), diagonal, self.speed), None),
             (Turn(heading, self.turn_rate), None),
         ]
 
@@ -378,7 +357,7 @@ class Navigator:
         # vertex, which carries that scan's error)
         self._incoming = (heading + math.pi) % (2.0 * math.pi)
         self._plan = deque([
-            *self._shift(heading, -1, angle=ARRIVAL_SHIFT_ANGLE),
+            *self._shift(heading, -1),
             (SeekLine(heading, self._approach_speed, self.conv.max_seek_m), self._found_spoke),
             (FollowSpoke(self._approach_speed), self._spoke_ended),
         ])
@@ -386,25 +365,10 @@ class Navigator:
     def _found_spoke(self, seek: SeekLine) -> None:
         if seek.failed:
             self._lose("no spoke found at the vertex")
-        self._spoke_seek = seek
 
     def _spoke_ended(self, spoke: FollowSpoke) -> None:
         """The sensor passed the spoke's inner end: the centre is ``line_ahead +
-        spoke_inner_radius`` beyond where the axle was then.
-
-        If the approach saw the spoke's outer end too (:data:`SPOKE_SEEK_MIN_M`), the
-        odometry's length of the spoke against its known ``spoke_radius_m -
-        spoke_inner_radius_m`` calibrates the odometry's distance scale (the mean over the
-        arrivals so far, as the scans' track): uncalibrated, slip 0.05 stopped the last
-        80 mm drive 3-4 mm short, which turned spokes square to the incoming one by up to
-        4 degrees in the angles a discoverer writes (issue 27)."""
-        odo, seek = self.odometry, self._spoke_seek
-        if seek.travelled_m >= SPOKE_SEEK_MIN_M:
-            known = self.conv.spoke_radius_m - self.conv.spoke_inner_radius_m
-            scale = odo.distance_scale * (spoke.ended_at_m - seek.found_at_m) / known
-            if DISTANCE_SCALE_RANGE[0] <= scale <= DISTANCE_SCALE_RANGE[1]:
-                self._distance_scales.append(scale)
-                odo.distance_scale = sum(self._distance_scales) / len(self._distance_scales)
+        spoke_inner_radius`` beyond where the axle was then."""
         heading = spoke.direction(self.odometry.theta)
         beyond = self.odometry.distance_m - spoke.ended_at_m
         centre = self.cal.line_ahead_m + self.conv.spoke_inner_radius_m - beyond

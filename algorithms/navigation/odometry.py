@@ -42,9 +42,6 @@ class Odometry:
                  theta: float = 0.0) -> None:
         self.cal = calibration
         self.track_m = calibration.track_m  # effective track, refined by calibration
-        #: encoder distance per true distance (1 until calibrated on a mark of known
-        #: length): wheel slip makes the encoders read more than the wheels rolled
-        self.distance_scale = 1.0
         self.x, self.y, self.theta = x, y, theta
         self.distance_m = 0.0  # total path length driven (forward counts positive)
         self._last: tuple[float, float] | None = None
@@ -62,7 +59,7 @@ class Odometry:
         dr = encoders[1] - self._last[1]
         self._last = encoders
         r, b = self.cal.wheel_radius_m, self.track_m
-        ds = r * (dl + dr) / 2.0 / self.distance_scale
+        ds = r * (dl + dr) / 2.0
         dtheta = r * (dr - dl) / b
         mid = self.theta + dtheta / 2.0
         self.x += ds * math.cos(mid)
