@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from algorithms.collision import CollisionRule
-from algorithms.navigation.motions import Scan
+from algorithms.navigation.motions import Scan, SeekLine
 from algorithms.navigation.odometry import Odometry, RobotCalibration
 from algorithms.navigation.percept import (
     LINE_THRESHOLD_M,
@@ -162,3 +162,54 @@ def test_noise_free_wall_readings_are_judged_one_by_one():
         assert watch(d)
     assert watch.confirm_ticks == 1
     assert not watch(math.nan)
+
+
+def test_the_speed_rule_sees_bearings_along_the_lane_not_the_swung_nose():
+    """``arena2``, 4 robots, 0.2 m/s, 0.5 mm line noise, kinematic (issue 27's sample): a
+    robot whose nose had swung 4.4 degrees on its lane saw a robot standing on the vertex
+    beyond the next one 1.3 degrees off its nose, inside the rule's 2.6 degree "same lane"
+    cone: it stopped for good, and that robot waited for the vertex it held. In the lane's
+    frame that robot is 5.7 degrees off (slow, not stop); the lane's direction does not
+    follow the nose while the robot stands."""
+    from algorithms.navigation.navigator import ArenaConventions, Navigator, NavigatorState
+
+    cal = RobotCalibration(wheel_radius_m=0.02, track_m=0.1, line_ahead_m=0.05,
+                           max_speed_m_s=0.2)
+    conv = ArenaConventions(lane_offset_m=0.09, spoke_inner_radius_m=0.03,
+                            spoke_radius_m=0.12, wall_distance_m=0.024, strip_width_m=0.03)
+    nav = Navigator(cal, conv, -math.pi / 2, 0.2)
+    wheels = [0.0, 0.0]
+    dt = 0.02
+
+    def tick(line, moving=True):
+        v, w = nav.update(percept([FLOOR_M - STRIP_M * on for on in line], (math.nan,) * 3,
+                                  tuple(wheels), nav.line_filter))
+        if moving:
+            wheels[0] += (v - w * cal.track_m / 2) / cal.wheel_radius_m * dt
+            wheels[1] += (v + w * cal.track_m / 2) / cal.wheel_radius_m * dt
+
+    tick((False, False, False))
+    nav.depart(-math.pi / 2)
+    while nav.state is not NavigatorState.ON_EDGE:  # the sidestep, then the lane ahead
+        tick((False, isinstance(nav._plan[0][0], SeekLine), False))
+    for _ in range(50):
+        tick((False, True, False))
+    theta_lane = nav.odometry.theta
+    for _ in range(3):  # the right sensor catches the strip's edge: a swing to the right
+        tick((False, True, True))
+    for _ in range(5):
+        tick((False, True, False))
+    swing = math.degrees(nav.odometry.theta - theta_lane)
+    assert swing < -3.0
+    ahead = {1: math.radians(-1.3)}  # a robot standing beyond, seen off the swung nose
+    raw, along = CollisionRule(0.2, 0.2, same_lane=0.045), CollisionRule(0.2, 0.2, same_lane=0.045)
+    for _ in range(20):
+        raw.update(ahead)
+        along.update(nav.lane_bearings(ahead))
+    assert raw.speed == 0.0  # teeth: the nose's bearing stops it
+    assert 0.0 < along.speed < 0.2  # the lane's: a robot off the lane, slow down
+    tick((False, True, False), moving=False)  # it stops (its last move is read now)
+    before = nav.lane_bearings(ahead)[1]
+    for _ in range(200):  # standing, its centre sensor alone on the strip
+        tick((False, True, False), moving=False)
+    assert nav.lane_bearings(ahead)[1] == pytest.approx(before)

@@ -303,7 +303,7 @@ class Explorer(Controller):
         if self.rule is not None:
             if nav.on_lane:  # the rule governs edge traversals
                 fired = self.rule.activations
-                speed = self.rule.update(observation.bearings)
+                speed = self.rule.update(nav.lane_bearings(observation.bearings))
                 if self.rule.activations != fired:
                     self._events.append(SpeedRuleFired(self.rule.activations - fired))
             else:

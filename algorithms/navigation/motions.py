@@ -36,6 +36,10 @@ END_CONFIRM_TICKS = 2
 #: ``1 - FULL_TURN_UNDER`` and ``1 + FULL_TURN_OVER`` turns since (see :func:`_same_spoke`).
 FULL_TURN_UNDER = 0.015
 FULL_TURN_OVER = 0.095
+#: FollowLine keeps a heading for its lane's direction at most once per this travel (m):
+#: half a control tick's travel at the paper's 0.05 m/s (1 mm at 50 Hz), so a moving robot
+#: keeps one per tick and a standing one none.
+HEADING_SAMPLE_M = 0.0005
 #: FollowSpoke holds its heading once the centre sensor alone has seen the spoke this far (m).
 SPOKE_ALIGN_M = 0.015
 
@@ -157,7 +161,10 @@ class FollowLine:
       keeps its last correction (the strip is beyond the outer sensor).
 
     ``headings`` keeps the odometry headings of the ticks where only the centre sensor
-    was on (the robot aligned with the strip), so callers can estimate its direction.
+    was on (the robot aligned with the strip), at most one per ``HEADING_SAMPLE_M`` of
+    travel, so callers can estimate its direction: a robot standing on its lane (the
+    speed rule, vertex entry) would otherwise pull the estimate onto whatever heading
+    its last swing left it at.
     """
 
     speed: float
@@ -167,6 +174,7 @@ class FollowLine:
     #: while the centre sensor tracks the strip: the side sensors on with it last tick
     _holding: tuple[bool, bool] | None = None
     _end: CentreEnd = field(default_factory=CentreEnd)
+    _sampled_m: float = -math.inf  # the odometry distance of the last heading kept
 
     def step(self, odo: Odometry, percept: Percept):
         left, centre, right = percept.line
@@ -187,8 +195,9 @@ class FollowLine:
             self.ended_at_m = None
             side = float(left) - float(right)
             self._position = side / 2.0 if centre else side
-            if self._position == 0.0:
+            if self._position == 0.0 and odo.distance_m - self._sampled_m >= HEADING_SAMPLE_M:
                 self.headings.append(odo.theta)
+                self._sampled_m = odo.distance_m
         else:
             if self.ended_at_m is None:
                 self.ended_at_m = seen_at_m

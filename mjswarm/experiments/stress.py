@@ -139,11 +139,25 @@ def _timed(run: StressRun) -> tuple[StressRun, EmbodiedResult, float]:
     return run, result, time.perf_counter() - start
 
 
-def run_grid(runs: list[StressRun], workers: int) -> list[tuple[StressRun, EmbodiedResult, float]]:
-    """Run ``runs`` on ``workers`` processes, with a progress bar; results in grid order."""
+def run_grid(runs: list[StressRun], workers: int, log=None,
+             max_heading_error_deg: float = math.inf) -> list[tuple[StressRun, EmbodiedResult, float]]:
+    """Run ``runs`` on ``workers`` processes, with a progress bar; results in grid order.
+    ``log``: a text file that gets one line per run as it is done, passed or not by
+    :func:`passed` with ``max_heading_error_deg`` (a long grid's partial results survive
+    an interruption)."""
+    done = []
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        done = list(tqdm(pool.map(_timed, runs), total=len(runs), unit="run",
-                         desc="stress grid", disable=not sys.stderr.isatty()))
+        for run, result, wall in tqdm(pool.map(_timed, runs), total=len(runs), unit="run",
+                                      desc="stress grid", disable=not sys.stderr.isatty()):
+            done.append((run, result, wall))
+            if log is not None:
+                print(f"{run.arena} k={run.robots} v={run.speed_m_s:g} {run.noise} "
+                      f"{run.physics} seed={run.seed}: {result.ended_because} "
+                      f"map={result.map_correct} contacts={result.collisions} "
+                      f"stopped={len(result.stopped_robots)} "
+                      f"heading={result.heading_error_deg:.1f} "
+                      f"pass={passed(result, max_heading_error_deg)} wall={wall:.0f}s",
+                      file=log, flush=True)
     return done
 
 
@@ -197,6 +211,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--noise", action="store_true",
                         help="run issue 27's noise grid instead (--arenas defaults to its "
                              "classes; every speed, noise level and physics tier)")
+    parser.add_argument("--log", type=argparse.FileType("a"), default=None, metavar="FILE",
+                        help="append one line per run to FILE as it is done")
     parser.add_argument("--sample", action="store_true",
                         help="with --noise: only 0.05 and 0.2 m/s, teams of 4 and one seed "
                              "(140 runs)")
@@ -214,7 +230,7 @@ def main(argv: list[str] | None = None) -> int:
     else:
         arenas = ARENAS if args.arenas is None else args.arenas.split(",")
         runs, heading = grid(arenas=arenas, seeds=range(args.seeds or 1)), math.inf
-    rows = run_grid(runs, args.workers)
+    rows = run_grid(runs, args.workers, args.log, heading)
     print(noise_table(rows) if args.noise else table(rows))
     failures = [(r, res) for r, res, _ in rows if not passed(res, heading)]
     for r, res in failures:
