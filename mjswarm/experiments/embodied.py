@@ -149,7 +149,9 @@ def same_lane_bearing(range_m: float) -> float:
     vertex beyond the one a robot drives to (vertex entry) is no obstacle, and stopping
     for it would wait for ever (issue 13, ``arena2`` with 4 robots: a robot waiting on v9
     for v5 stopped the robot driving from v3 to v5). A robot on the opposite lane is
-    twice as far off again."""
+    twice as far off again. The rule gets its bearings in the lane's frame (the
+    navigator's ``lane_bearings``: bearing + heading - lane direction), so a nose turned a
+    few degrees off the lane does not bring such a robot into the cone (issue 27)."""
     return math.atan2(LANE_OFFSET_M / 2.0, range_m)
 
 
