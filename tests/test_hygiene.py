@@ -6,6 +6,8 @@ beacons), the Radio, MuJoCo's model or data, or a robot's controller."""
 
 from __future__ import annotations
 
+import math
+
 import mujoco
 import numpy as np
 import pytest
@@ -154,3 +156,29 @@ def test_old_beacon_handles_raise_in_the_graph_world():
     robot = Hoarder()
     Loop(world, {0: robot}).run(max_ticks=3)
     assert robot.errors == 0 + 1 + 2
+
+
+def test_coverage_hands_out_nothing_forbidden(watched):
+    from mjswarm.experiments.coverage import CoverageRun
+
+    CoverageRun(2.0, "heuristic", "point", seed=0).run(3)
+    _clean(watched, 100)  # the add / remove protocol's messages
+
+
+def test_patrol_hands_out_nothing_forbidden(watched):
+    from mjswarm.experiments.patrol import run_trial
+
+    run_trial(6, 0, "point", steps=60)
+    _clean(watched, 100)
+
+
+@pytest.mark.parametrize("method", ["stamps", "tables", "tables-2"])
+def test_the_connectivity_checks_hand_out_nothing_forbidden(watched, method):
+    from mjswarm.experiments.connectivity.harness import run_check
+    from mjswarm.experiments.connectivity.team import Team
+
+    ring = Team(positions={f"r{i}": (math.cos(i * math.pi / 4), math.sin(i * math.pi / 4))
+                           for i in range(8)})
+    result = run_check(ring, method, range_m=0.9)
+    assert result.connected and result.biconnected
+    _clean(watched, 8)
