@@ -213,3 +213,19 @@ def test_the_speed_rule_sees_bearings_along_the_lane_not_the_swung_nose():
     for _ in range(200):  # standing, its centre sensor alone on the strip
         tick((False, True, False), moving=False)
     assert nav.lane_bearings(ahead)[1] == pytest.approx(before)
+
+
+def test_the_running_median_equals_the_median_of_the_last_values():
+    import statistics
+    from collections import deque
+
+    from algorithms.navigation.percept import RunningMedian
+
+    rng = np.random.default_rng(7)
+    for size in (1, 2, 5, 450):
+        running, window = RunningMedian(size), deque(maxlen=size)
+        for value in rng.choice([0.0, 1e-4, 2e-4, 3e-4], 2000) + rng.normal(0, 1e-4, 2000) * (
+                rng.random(2000) < 0.5):
+            running.append(float(value))
+            window.append(float(value))
+            assert running.median() == statistics.median(window)

@@ -8,8 +8,8 @@ only: the level its sensors read over the bare floor, and their noise.
 
 from __future__ import annotations
 
+import bisect
 import math
-import statistics
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -37,6 +37,36 @@ NOISE_MIN_SAMPLES = 30
 FLOOR_RATE = 1.0 / 50.0
 #: The median of ``|a - b|`` for two independent ``N(0, sigma^2)`` readings, in sigmas.
 _MEDIAN_ABS_DIFF = 0.6744897501960817 * math.sqrt(2.0)
+
+
+class RunningMedian:
+    """The median of the last ``size`` values (m), kept sorted as they come and go: a
+    control tick costs a binary search and a short memory move, not a sort of them all
+    (the noise estimates below ask every tick). The same number as
+    :func:`statistics.median` of the values."""
+
+    def __init__(self, size: int) -> None:
+        self._recent: deque[float] = deque(maxlen=size)
+        self._sorted: list[float] = []
+
+    def __len__(self) -> int:
+        return len(self._recent)
+
+    def append(self, value: float) -> None:
+        if len(self._recent) == self._recent.maxlen:
+            del self._sorted[bisect.bisect_left(self._sorted, self._recent[0])]
+        self._recent.append(value)
+        bisect.insort(self._sorted, value)
+
+    def median(self) -> float:
+        values, n = self._sorted, len(self._sorted)
+        return values[n // 2] if n % 2 else (values[n // 2 - 1] + values[n // 2]) / 2
+
+
+def noise_estimate(diffs: RunningMedian, least: int) -> float | None:
+    """A noise standard deviation (m) from the median of ``|reading - previous
+    reading|`` of a sensor; None while fewer than ``least`` differences are in."""
+    return None if len(diffs) < least else diffs.median() / _MEDIAN_ABS_DIFF
 
 
 @dataclass(frozen=True)
@@ -92,15 +122,13 @@ class LineFilter:
         self.floor_m = line_floor_m
         self.window = LINE_WINDOW_MAX
         self._readings = tuple(deque(maxlen=LINE_WINDOW_MAX) for _ in range(3))
-        self._diffs: deque[float] = deque(maxlen=NOISE_SAMPLES)
+        self._diffs = RunningMedian(NOISE_SAMPLES)
         self._on = [False, False, False]
 
     @property
     def noise_m(self) -> float | None:
         """The estimated noise standard deviation (m), None while too few readings."""
-        if len(self._diffs) < NOISE_MIN_SAMPLES:
-            return None
-        return statistics.median(self._diffs) / _MEDIAN_ABS_DIFF
+        return noise_estimate(self._diffs, NOISE_MIN_SAMPLES)
 
     def __call__(self, line_m: Sequence[float]) -> tuple[tuple[bool, bool, bool], int]:
         """Take this tick's readings (m); return whether each sensor sees a strip and
@@ -162,16 +190,14 @@ class WallWatch:
 
     def __init__(self, wall_distance_m: float, tolerance_m: float) -> None:
         self.wall_distance_m, self.tolerance_m = wall_distance_m, tolerance_m
-        self._diffs: deque[float] = deque(maxlen=NOISE_SAMPLES)
+        self._diffs = RunningMedian(NOISE_SAMPLES)
         self._last_wall: float | None = None  # the previous reading, if it saw the wall
         self._missed = WALL_CONFIRM_MAX  # readings in a row without the wall
 
     @property
     def noise_m(self) -> float | None:
         """The estimated noise standard deviation (m), None while too few readings."""
-        if len(self._diffs) < WALL_NOISE_MIN_SAMPLES:
-            return None
-        return statistics.median(self._diffs) / _MEDIAN_ABS_DIFF
+        return noise_estimate(self._diffs, WALL_NOISE_MIN_SAMPLES)
 
     @property
     def confirm_ticks(self) -> int:
