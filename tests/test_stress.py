@@ -51,6 +51,21 @@ def test_table_counts_what_it_ran():
     assert "| `issue13-fan` | 1 | 1 | 1 | 0 | 0 |" in text
 
 
+#: Issue 30's dense teams at the top speed, one robot for every 5 edges, that stalled:
+#: a robot on its lane stopped for good (speed rule, beta = 0) for one standing on the
+#: centre of the vertex beyond the next, and that one waited for the vertex the first
+#: held. The rule now takes bearings in the lane's frame (issue 27's lane_bearings), so a
+#: nose turned a few degrees off the lane no longer brings such a robot into the cone.
+DENSE = [StressRun("lattice:6x6", 12, 0.2, 1), StressRun("lattice:8x8", 16, 0.2, 2)]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("run", DENSE, ids=str)
+def test_dense_teams_at_top_speed_complete(run):
+    result = run.run(max_sim_time_s=2400.0)
+    assert passed(result), (result.ended_because, result.collisions, result.stopped_robots)
+
+
 @pytest.mark.slow
 def test_the_whole_grid_passes():
     rows = run_grid(grid(), workers=2)
