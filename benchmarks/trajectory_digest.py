@@ -37,7 +37,7 @@ def _hook(sim, digest: "hashlib._Hash") -> None:
 def exploration(arena: str, robots: int) -> None:
     from mjswarm.arena import load_arena
     from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
-    from mjswarm.worlds.graphworld import make_minds
+    from mjswarm.experiments.minds import make_minds
 
     digest = hashlib.sha256()
     run = EmbodiedExploration(load_arena(arena), make_minds("incidence-dfs", robots),

@@ -129,6 +129,17 @@ def _short(value: Any) -> str:
 
 
 
+def _check_options(range_m: float | None, edges, drop_prob: float) -> None:
+    """Refuse, in one line, a radio with both or neither of a range (m) and explicit
+    edges, a range that is not a positive number, or a drop probability outside [0, 1)."""
+    if (range_m is None) == (edges is None):
+        raise MjswarmError("radio: give exactly one of a range (metres) or explicit edges")
+    if range_m is not None and not (math.isfinite(range_m) and range_m > 0):
+        raise MjswarmError(f"radio: range must be a positive number of metres, got {range_m}")
+    if not 0.0 <= drop_prob < 1.0:
+        raise MjswarmError(f"radio: drop probability must be in [0, 1), got {drop_prob}")
+
+
 class Radio:
     """Broadcast radio with range d_c (or explicit links), one-tick latency, drops, counters.
 
@@ -164,12 +175,7 @@ class Radio:
                 self._ids[k] = r
         if len(self._index) != len(self.robots):
             raise MjswarmError("radio: duplicate robot ids")
-        if (range_m is None) == (edges is None):
-            raise MjswarmError("radio: give exactly one of a range (metres) or explicit edges")
-        if range_m is not None and not (math.isfinite(range_m) and range_m > 0):
-            raise MjswarmError(f"radio: range must be a positive number of metres, got {range_m}")
-        if not 0.0 <= drop_prob < 1.0:
-            raise MjswarmError(f"radio: drop probability must be in [0, 1), got {drop_prob}")
+        _check_options(range_m, edges, drop_prob)
         self.range_m = range_m
         self.blocked = blocked
         self.drop_prob = float(drop_prob)

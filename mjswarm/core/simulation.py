@@ -78,6 +78,24 @@ def _robot_count(spec: mujoco.MjSpec) -> int:
     return sum(1 for b in spec.bodies if b.name.endswith(f"/{ROOT_BODY}"))
 
 
+def _check_options(control_hz: float, line_noise_m: float, ir_noise_m: float,
+                   wheel_slip: float, sensing: str, physics: str) -> None:
+    """Refuse, in one line, options a :class:`Simulation` cannot run with."""
+    if control_hz <= 0:
+        raise MjswarmError(f"control rate must be positive, got {control_hz} Hz")
+    if line_noise_m < 0 or ir_noise_m < 0:
+        raise MjswarmError("sensor noise standard deviations must be >= 0")
+    if not 0.0 <= wheel_slip < 1.0:
+        raise MjswarmError(f"wheel slip must be in [0, 1), got {wheel_slip}")
+    if sensing not in SENSING:
+        raise MjswarmError(f"sensing must be one of {', '.join(SENSING)}, got '{sensing}'")
+    if physics not in PHYSICS:
+        raise MjswarmError(f"physics must be one of {', '.join(PHYSICS)}, got '{physics}'")
+    if physics == "kinematic" and sensing == "mujoco":
+        raise MjswarmError("the kinematic tier senses with the ray caster: use sensing "
+                           "'grid' or 'auto' with physics 'kinematic'")
+
+
 class Simulation:
     """N robots stepping together.
 
@@ -109,19 +127,7 @@ class Simulation:
         wheel_slip: float = 0.0,
         physics: str = "dynamic",
     ) -> None:
-        if control_hz <= 0:
-            raise MjswarmError(f"control rate must be positive, got {control_hz} Hz")
-        if line_noise_m < 0 or ir_noise_m < 0:
-            raise MjswarmError("sensor noise standard deviations must be >= 0")
-        if not 0.0 <= wheel_slip < 1.0:
-            raise MjswarmError(f"wheel slip must be in [0, 1), got {wheel_slip}")
-        if sensing not in SENSING:
-            raise MjswarmError(f"sensing must be one of {', '.join(SENSING)}, got '{sensing}'")
-        if physics not in PHYSICS:
-            raise MjswarmError(f"physics must be one of {', '.join(PHYSICS)}, got '{physics}'")
-        if physics == "kinematic" and sensing == "mujoco":
-            raise MjswarmError("the kinematic tier senses with the ray caster: use sensing "
-                               "'grid' or 'auto' with physics 'kinematic'")
+        _check_options(control_hz, line_noise_m, ir_noise_m, wheel_slip, sensing, physics)
         sensor_bit = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
         flags = spec.option.disableflags
         if physics == "kinematic" or sensing == "grid" or (
@@ -151,29 +157,7 @@ class Simulation:
         self.rng = np.random.default_rng(seed)
         self.line_noise_m, self.ir_noise_m = line_noise_m, ir_noise_m
         self.wheel_slip = wheel_slip
-
-        def ids(obj, names):
-            return np.array(
-                [[mujoco.mj_name2id(m, obj, f"r{i}/{n}") for n in names] for i in range(self.n)],
-                dtype=np.int64,
-            ).reshape(self.n, len(names))
-
-        sens = mujoco.mjtObj.mjOBJ_SENSOR
-        self._actuators = ids(mujoco.mjtObj.mjOBJ_ACTUATOR, ACTUATORS)
-        self._range_ids = ids(sens, LINE_SENSORS + IR_SENSORS)  # (N, 6): line, then IR
-        self._range_adr = m.sensor_adr[self._range_ids]
-        self._range_cutoff = m.sensor_cutoff[self._range_ids]
-        self._range_site = m.sensor_objid[self._range_ids].ravel()
-        self._range_length = np.where(self._range_cutoff > 0, self._range_cutoff, UNBOUNDED_PROBE_M).ravel()
-        self._enc_adr = m.sensor_adr[ids(sens, ENCODERS)]
-        self._vel_adr = m.sensor_adr[ids(sens, WHEEL_SPEED_SENSORS)]
-        wheel_joints = m.sensor_objid[ids(sens, ENCODERS)]
-        self._wheel_qpos_adr = m.jnt_qposadr[wheel_joints]
-        self._wheel_dof_adr = m.jnt_dofadr[wheel_joints]
-        self.robot_bodies = ids(mujoco.mjtObj.mjOBJ_BODY, (ROOT_BODY,))[:, 0]
-        joints = m.body_jntadr[self.robot_bodies]
-        self._qpos_adr = m.jnt_qposadr[joints]
-        self._pose_qpos = self._qpos_adr[:, None] + np.arange(7)  # free joints: xyz, quat
+        self._index_robots()
         geom_robot = self._body_robot()[m.geom_bodyid]
         self.geom_robot = geom_robot
         if self.n == 0:
@@ -203,6 +187,35 @@ class Simulation:
         self._no_torque = np.zeros((self.n, 2))
         self._wheel_cmd = np.zeros((self.n, 2))  # set_velocity's buffer
         self._sense_now()
+
+    def _index_robots(self) -> None:
+        """Where each robot's actuators, sensors, wheel joints and free joint live in
+        the compiled model and its data (robots are attached with prefixes r0/, r1/, ...)."""
+        m = self.model
+
+        def ids(obj, names):
+            return np.array(
+                [[mujoco.mj_name2id(m, obj, f"r{i}/{n}") for n in names] for i in range(self.n)],
+                dtype=np.int64,
+            ).reshape(self.n, len(names))
+
+        sens = mujoco.mjtObj.mjOBJ_SENSOR
+        self._actuators = ids(mujoco.mjtObj.mjOBJ_ACTUATOR, ACTUATORS)
+        self._range_ids = ids(sens, LINE_SENSORS + IR_SENSORS)  # (N, 6): line, then IR
+        self._range_adr = m.sensor_adr[self._range_ids]
+        self._range_cutoff = m.sensor_cutoff[self._range_ids]
+        self._range_site = m.sensor_objid[self._range_ids].ravel()
+        self._range_length = np.where(self._range_cutoff > 0, self._range_cutoff,
+                                      UNBOUNDED_PROBE_M).ravel()
+        self._enc_adr = m.sensor_adr[ids(sens, ENCODERS)]
+        self._vel_adr = m.sensor_adr[ids(sens, WHEEL_SPEED_SENSORS)]
+        wheel_joints = m.sensor_objid[ids(sens, ENCODERS)]
+        self._wheel_qpos_adr = m.jnt_qposadr[wheel_joints]
+        self._wheel_dof_adr = m.jnt_dofadr[wheel_joints]
+        self.robot_bodies = ids(mujoco.mjtObj.mjOBJ_BODY, (ROOT_BODY,))[:, 0]
+        joints = m.body_jntadr[self.robot_bodies]
+        self._qpos_adr = m.jnt_qposadr[joints]
+        self._pose_qpos = self._qpos_adr[:, None] + np.arange(7)  # free joints: xyz, quat
 
     @property
     def rays(self) -> RayCaster:

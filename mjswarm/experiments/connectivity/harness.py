@@ -101,6 +101,18 @@ def drive(
     return start + loop.ticks - 1, stop.capped
 
 
+def _checkers(method: str, ids: tuple, leader, max_robots: int | None) -> dict:
+    """Every robot's mind for ``method``: the stamps check of seed 002 or the
+    connectivity tables of seed 004 (forwarding two tables with ``tables-2``)."""
+    n = len(ids)
+    if method == "stamps":
+        return {r: BiconnectivityCheck(r, n, max_robots=max_robots, initiator=r == leader)
+                for r in ids}
+    forwards = 2 if method == "tables-2" else None
+    return {r: TableCheck(r, leader, n, max_robots=max_robots, max_forwards=forwards)
+            for r in ids}
+
+
 def run_check(
     team: Team,
     method: str,
@@ -136,17 +148,7 @@ def run_check(
     if message_cap is not None and message_cap < 1:
         raise MjswarmError(f"message cap must be at least 1, got {message_cap}")
     radio = team.radio(range_m, drop_prob=drop_prob, rng=seed)
-    if method == "stamps":
-        nodes = {
-            r: BiconnectivityCheck(r, n, max_robots=max_robots, initiator=r == leader)
-            for r in ids
-        }
-    else:
-        forwards = 2 if method == "tables-2" else None
-        nodes = {
-            r: TableCheck(r, leader, n, max_robots=max_robots, max_forwards=forwards)
-            for r in ids
-        }
+    nodes = _checkers(method, ids, leader, max_robots)
     decider = nodes[leader]
     rounds, capped = drive(
         radio,
