@@ -96,6 +96,25 @@ def _check_options(control_hz: float, line_noise_m: float, ir_noise_m: float,
                            "'grid' or 'auto' with physics 'kinematic'")
 
 
+def _compile(spec: mujoco.MjSpec, physics: str, sensing: str) -> mujoco.MjModel:
+    """Compile the world, with MuJoCo's sensors off when the ray caster will sense."""
+    sensor_bit = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+    flags = spec.option.disableflags
+    if physics == "kinematic" or sensing == "grid" or (
+            sensing == "auto" and _robot_count(spec) >= GRID_SENSING_MIN_ROBOTS):
+        # compiling evaluates every sensor once (mj_setConst steps through mj_forward):
+        # for grid sensing, N robots' rangefinders against every geom, O(N^2), that
+        # nobody reads (20 s of a 10,000-robot build); the flag is set below anyway
+        spec.option.disableflags = flags | sensor_bit
+    try:
+        with quiet_empty_prefix():  # robots attached in groups (world.attach_robots)
+            return spec.compile()
+    except ValueError as exc:
+        raise MjswarmError(f"world does not compile: {one_line(exc)}") from None
+    finally:
+        spec.option.disableflags = flags  # the caller's spec as it was
+
+
 class Simulation:
     """N robots stepping together.
 
@@ -128,21 +147,7 @@ class Simulation:
         physics: str = "dynamic",
     ) -> None:
         _check_options(control_hz, line_noise_m, ir_noise_m, wheel_slip, sensing, physics)
-        sensor_bit = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
-        flags = spec.option.disableflags
-        if physics == "kinematic" or sensing == "grid" or (
-                sensing == "auto" and _robot_count(spec) >= GRID_SENSING_MIN_ROBOTS):
-            # compiling evaluates every sensor once (mj_setConst steps through mj_forward):
-            # for grid sensing, N robots' rangefinders against every geom, O(N^2), that
-            # nobody reads (20 s of a 10,000-robot build); the flag is set below anyway
-            spec.option.disableflags = flags | sensor_bit
-        try:
-            with quiet_empty_prefix():  # robots attached in groups (world.attach_robots)
-                self.model = spec.compile()
-        except ValueError as exc:
-            raise MjswarmError(f"world does not compile: {one_line(exc)}") from None
-        finally:
-            spec.option.disableflags = flags  # the caller's spec as it was
+        self.model = _compile(spec, physics, sensing)
         self.data = mujoco.MjData(self.model)
         m = self.model
         self.n = sum(1 for b in range(m.nbody) if m.body(b).name.endswith(f"/{ROOT_BODY}"))
