@@ -250,8 +250,11 @@ class Recorder:
         self._stream.send_blueprint(_blueprint(bounds_m, n, trail_window_s, radio, sensors,
                                                video))
         self._closed = False
+        self._buffers(self._chunk, n)
+        self._log_static(arena, float(robot_radius_m))
 
-        b = self._chunk
+    def _buffers(self, b: int, n: int) -> None:
+        """The buffers of ``b`` ticks of ``n`` robots that :meth:`log_tick` fills."""
         self._rows = 0
         self._steps = np.zeros(b, dtype=np.int64)
         self._times = np.zeros(b)
@@ -269,8 +272,6 @@ class Recorder:
         self._latest_xy: np.ndarray | None = None  # (n, 2): last position logged
         self._last_map: dict[int, tuple] = {}
         self._state: dict[tuple[int, str], tuple[list[int], list[float]]] = {}
-
-        self._log_static(arena, float(robot_radius_m))
 
     # --- static data -------------------------------------------------------------------
 
@@ -354,21 +355,8 @@ class Recorder:
         """
         self._check_open()
         n = self.n_robots
-        readings = (line, ir, bearings, encoders, battery)
-        if self.sensors and any(r is None for r in readings):
-            raise ValueError("log_tick: this recording needs every sensor reading")
-        if not self.sensors and any(r is not None for r in readings):
-            raise ValueError("log_tick: this recording was made without sensors")
         speed = np.zeros(n) if speed is None else speed
-        checks = [("poses", poses, (n, 3)), ("speed", speed, (n,))]
-        if self.sensors:
-            checks += [("line", line, (n, 3)), ("ir", ir, (n, 3)),
-                       ("encoders", encoders, (n, 2)), ("battery", battery, (n,))]
-            if len(bearings) != n:
-                raise ValueError(f"log_tick: bearings has {len(bearings)} entries, expected {n}")
-        for name, value, shape in checks:
-            if np.shape(value) != shape:
-                raise ValueError(f"log_tick: {name} has shape {np.shape(value)}, expected {shape}")
+        self._check_tick(poses, speed, line, ir, bearings, encoders, battery)
         k = self._rows
         self._steps[k] = step
         self._times[k] = sim_time_s
@@ -392,6 +380,25 @@ class Recorder:
         self._rows = k + 1
         if self._rows == self._chunk:
             self._send_ticks()
+
+    def _check_tick(self, poses, speed, line, ir, bearings, encoders, battery) -> None:
+        """:meth:`log_tick`'s arguments have the shapes of this recording's robots, and
+        the sensor readings are there exactly when the recording has sensors."""
+        n = self.n_robots
+        readings = (line, ir, bearings, encoders, battery)
+        if self.sensors and any(r is None for r in readings):
+            raise ValueError("log_tick: this recording needs every sensor reading")
+        if not self.sensors and any(r is not None for r in readings):
+            raise ValueError("log_tick: this recording was made without sensors")
+        checks = [("poses", poses, (n, 3)), ("speed", speed, (n,))]
+        if self.sensors:
+            checks += [("line", line, (n, 3)), ("ir", ir, (n, 3)),
+                       ("encoders", encoders, (n, 2)), ("battery", battery, (n,))]
+            if len(bearings) != n:
+                raise ValueError(f"log_tick: bearings has {len(bearings)} entries, expected {n}")
+        for name, value, shape in checks:
+            if np.shape(value) != shape:
+                raise ValueError(f"log_tick: {name} has shape {np.shape(value)}, expected {shape}")
 
     def _send_ticks(self) -> None:
         """Send the buffered ticks as columns (one ``send_columns`` per entity)."""
