@@ -130,113 +130,14 @@ class RadioGraphWorld:
     def run(self, minds: list[Strategy], *, seed: int | None = None,
             max_time: float | None = None, arena: str = "<graph>") -> ConnectedExplorationResult:
         """Explore with ``minds`` (one per robot) from the root (module docstring)."""
-        w, k = self.world, len(minds)
+        need_robots(self.connectivity, len(minds))
         if max_time is None:
-            max_time = 50 * (len(w.edges) + 1) + 100
-        constrained = self.connectivity != "none"
-        need_robots(self.connectivity, k)
-        need = NEED.get(self.connectivity, 1)
-        # rule 1 for biconnected: robot 0 docks at the base (it stands on the root)
-        dock = docked(Flooder()) if need == 2 else None
-        robots = [None if dock is not None and i == 0 else
-                  ConnectedExplorer(i, minds[i], Tether(i, self.range_m, initial_parents(i, need),
-                                                        ticks_per_unit=TICKS_PER_UNIT))
-                  for i in range(k)]
-        base = BaseStation(Flooder())
-        beacons = {v: Beacon() for v in w.graph}
-        beacon_vertex: dict[str, str] = {}
-        at: list[str | None] = [w.root] * k  # vertex, or None on an edge
-        edge: list[tuple[str, str] | None] = [None] * k
-        progress = [0.0] * k  # share of the edge behind the robot
-        xy = np.array([self.pos[w.root]] * (k + 1))  # robots, then the base
-        arrived_by: list[float | None] = [None] * k
-        wake = [0] * k  # tick at which a robot at a vertex decides
-        paths = [[w.root] for _ in range(k)]
-        radio = Radio(list(range(k)) + [BASE], range_m=self.range_m)
-        radio.move(xy)
-        declared = infeasible = None
-        cut = fragile = ticks = 0
-        order = [i for i in range(k - 1, -1, -1) if robots[i] is not None]
+            max_time = 50 * (len(self.world.edges) + 1) + 100
+        run = _ConnectedRun(self, minds)
         last_tick = math.floor(max_time * TICKS_PER_UNIT)
-        while declared is None and infeasible is None and ticks < last_tick:
-            tick = ticks = ticks + 1
-            if constrained:  # deliver; the links are those of the last tick's end
-                radio.step()
-                around = [self._around(radio, i, xy) for i in range(k)]
-                for i in order:
-                    for m in robots[i].hear(tick, radio.receive(i), around[i]):
-                        radio.send(i, m.payload, m.to)
-                for m in base.step(radio.receive(BASE)):
-                    radio.send(BASE, m.payload, m.to)
-                if dock is not None:
-                    for m in dock.step(radio.receive(0)):
-                        radio.send(0, m.payload, m.to)
-            deciding = [i for i in order if at[i] is not None and wake[i] <= tick]
-            for i in deciding:  # bookkeeping first, then decisions (graph world)
-                robots[i].arrive(beacons[at[i]], w.angles[at[i]], arrived_by[i])
-            for i in deciding:
-                v = at[i]
-                decision = robots[i].on_vertex(beacons[v], w.angles[v], arrived_by[i])
-                if beacons[v].id is not None and beacons[v].id not in beacon_vertex:
-                    beacon_vertex[beacons[v].id] = v
-                if decision.action == "go":
-                    u = w.nearest_exit(v, decision.angle)[0]
-                    at[i], edge[i], progress[i], arrived_by[i] = None, (v, u), 0.0, w.angle_of[(u, v)]
-                elif decision.action == "idle":
-                    arrived_by[i], wake[i] = None, tick + TICKS_PER_UNIT
-                elif decision.action == "done":
-                    declared = (tick / TICKS_PER_UNIT, i, v)
-                    break
-                else:
-                    raise ValueError(f"robot {i + 1} answered an unknown decision {decision!r}")
-            if declared is not None:
-                break
-            wanted: dict[int, tuple[float, float]] = {}
-            moved = set()
-            for i in order:
-                if edge[i] is None:
-                    continue
-                sense = robots[i].direction(progress[i]) if constrained else 1
-                if sense == 0:
-                    continue
-                v, u = edge[i]
-                share, step = self._step(edge[i], progress[i], sense)
-                if constrained and not robots[i].tether.may_step(step, around[i]):
-                    wanted[i] = step
-                    continue
-                moved.add(i)
-                progress[i] += sense * share
-                if sense > 0 and progress[i] >= 1.0 - 1e-9:
-                    at[i], edge[i], wake[i] = u, None, tick + 1
-                    paths[i].append(u)
-                elif sense < 0 and progress[i] <= 1e-9:
-                    at[i], edge[i], wake[i], arrived_by[i] = v, None, tick + 1, w.angle_of[(v, u)]
-                    robots[i].arrived_back()
-                xy[i] = self.pos[v] + progress[i] * (self.pos[u] - self.pos[v])
-            if constrained:
-                radio.move(xy)
-                for i in order:
-                    for m in robots[i].after(tick, wanted.get(i), i in moved,
-                                             self._around(radio, i, xy)):
-                        radio.send(i, m.payload, m.to)
-                if any(robots[i].tether.stalled(tick) for i in order):
-                    infeasible = tick
-            graph = self._radio_graph(xy)
-            cut += not nx.is_connected(graph)
-            fragile += not nx.is_biconnected(graph)
-        completed_at = None if declared is None else declared[0]
-        fields = outcome(strategy_name(minds), declared,
-                         () if declared is None else minds[declared[1]].map_edges(),
-                         completed_at, paths, beacon_vertex, w.edges,
-                         arena=arena, root=w.root, edge_time=w.edge_time, seed=seed)
-        reason = None if infeasible is None else infeasible_reason(k, self.range_m, paths,
-                                                                   len(w.edges))
-        return ConnectedExplorationResult(
-            **fields, connectivity=self.connectivity, radio_range_m=self.range_m,
-            messages=radio.total_sent, connected_share=1.0 - cut / max(ticks, 1),
-            cut_ticks=cut, biconnected_share=1.0 - fragile / max(ticks, 1),
-            fragile_ticks=fragile, relay_trips=sum(robots[i].relay_trips for i in order),
-            infeasible=infeasible is not None, reason=reason)
+        while run.declared is None and run.infeasible is None and run.ticks < last_tick:
+            run.tick()
+        return run.result(seed, arena)
 
     def _step(self, e: tuple[str, str], progress: float,
               sense: int) -> tuple[float, tuple[float, float]]:
@@ -261,3 +162,149 @@ class RadioGraphWorld:
         d2 = ((xy[:, None] - xy[None]) ** 2).sum(axis=-1)
         g.add_edges_from(zip(*np.nonzero(np.triu(d2 <= self.range_m**2, 1))))
         return g
+
+
+class _ConnectedRun:
+    """One run of a :class:`RadioGraphWorld`: its state, and one tick in the phases of
+    the module docstring (:meth:`tick`)."""
+
+    def __init__(self, radio_world: RadioGraphWorld, minds: list[Strategy]) -> None:
+        self.rw, self.minds = radio_world, minds
+        w, k = radio_world.world, len(minds)
+        self.constrained = radio_world.connectivity != "none"
+        need = NEED.get(radio_world.connectivity, 1)
+        # rule 1 for biconnected: robot 0 docks at the base (it stands on the root)
+        self.dock = docked(Flooder()) if need == 2 else None
+        self.robots = [None if self.dock is not None and i == 0 else
+                       ConnectedExplorer(i, minds[i], Tether(
+                           i, radio_world.range_m, initial_parents(i, need),
+                           ticks_per_unit=TICKS_PER_UNIT))
+                       for i in range(k)]
+        self.base = BaseStation(Flooder())
+        self.beacons = {v: Beacon() for v in w.graph}
+        self.beacon_vertex: dict[str, str] = {}
+        self.at: list[str | None] = [w.root] * k  # vertex, or None on an edge
+        self.edge: list[tuple[str, str] | None] = [None] * k
+        self.progress = [0.0] * k  # share of the edge behind the robot
+        self.xy = np.array([radio_world.pos[w.root]] * (k + 1))  # robots, then the base
+        self.arrived_by: list[float | None] = [None] * k
+        self.wake = [0] * k  # tick at which a robot at a vertex decides
+        self.paths = [[w.root] for _ in range(k)]
+        self.radio = Radio(list(range(k)) + [BASE], range_m=radio_world.range_m)
+        self.radio.move(self.xy)
+        self.declared: tuple[float, int, str] | None = None
+        self.infeasible: int | None = None
+        self.cut = self.fragile = self.ticks = 0
+        self.order = [i for i in range(k - 1, -1, -1) if self.robots[i] is not None]
+        self.around: list[dict] = []
+
+    def tick(self) -> None:
+        """Hear, decide, move, answer, and the ground truth."""
+        self.ticks = tick = self.ticks + 1
+        if self.constrained:
+            self._hear(tick)
+        self._decide(tick)
+        if self.declared is not None:
+            return
+        wanted, moved = self._move(tick)
+        if self.constrained:
+            self._answer(tick, wanted, moved)
+        graph = self.rw._radio_graph(self.xy)
+        self.cut += not nx.is_connected(graph)
+        self.fragile += not nx.is_biconnected(graph)
+
+    def _send(self, sender, messages) -> None:
+        for m in messages:
+            self.radio.send(sender, m.payload, m.to)
+
+    def _hear(self, tick: int) -> None:
+        """Deliver (the links are those of the last tick's end); everyone reads."""
+        radio, xy = self.radio, self.xy
+        radio.step()
+        self.around = [self.rw._around(radio, i, xy) for i in range(len(self.minds))]
+        for i in self.order:
+            self._send(i, self.robots[i].hear(tick, radio.receive(i), self.around[i]))
+        self._send(BASE, self.base.step(radio.receive(BASE)))
+        if self.dock is not None:
+            self._send(0, self.dock.step(radio.receive(0)))
+
+    def _decide(self, tick: int) -> None:
+        """Robots at a vertex whose time has come: all bookkeeping first, then the
+        decisions one after another (the graph world's order)."""
+        w, at, robots, beacons = self.rw.world, self.at, self.robots, self.beacons
+        deciding = [i for i in self.order if at[i] is not None and self.wake[i] <= tick]
+        for i in deciding:
+            robots[i].arrive(beacons[at[i]], w.angles[at[i]], self.arrived_by[i])
+        for i in deciding:
+            v = at[i]
+            decision = robots[i].on_vertex(beacons[v], w.angles[v], self.arrived_by[i])
+            if beacons[v].id is not None and beacons[v].id not in self.beacon_vertex:
+                self.beacon_vertex[beacons[v].id] = v
+            if decision.action == "go":
+                u = w.nearest_exit(v, decision.angle)[0]
+                at[i], self.edge[i], self.progress[i] = None, (v, u), 0.0
+                self.arrived_by[i] = w.angle_of[(u, v)]
+            elif decision.action == "idle":
+                self.arrived_by[i], self.wake[i] = None, tick + TICKS_PER_UNIT
+            elif decision.action == "done":
+                self.declared = (tick / TICKS_PER_UNIT, i, v)
+                return
+            else:
+                raise ValueError(f"robot {i + 1} answered an unknown decision {decision!r}")
+
+    def _move(self, tick: int) -> tuple[dict[int, tuple[float, float]], set[int]]:
+        """Every robot on an edge takes its step if its tether allows; the steps it
+        wanted and could not take, and who moved."""
+        w, rw, robots = self.rw.world, self.rw, self.robots
+        wanted: dict[int, tuple[float, float]] = {}
+        moved = set()
+        for i in self.order:
+            if self.edge[i] is None:
+                continue
+            sense = robots[i].direction(self.progress[i]) if self.constrained else 1
+            if sense == 0:
+                continue
+            v, u = self.edge[i]
+            share, step = rw._step(self.edge[i], self.progress[i], sense)
+            if self.constrained and not robots[i].tether.may_step(step, self.around[i]):
+                wanted[i] = step
+                continue
+            moved.add(i)
+            self.progress[i] += sense * share
+            if sense > 0 and self.progress[i] >= 1.0 - 1e-9:
+                self.at[i], self.edge[i], self.wake[i] = u, None, tick + 1
+                self.paths[i].append(u)
+            elif sense < 0 and self.progress[i] <= 1e-9:
+                self.at[i], self.edge[i], self.wake[i] = v, None, tick + 1
+                self.arrived_by[i] = w.angle_of[(v, u)]
+                robots[i].arrived_back()
+            self.xy[i] = rw.pos[v] + self.progress[i] * (rw.pos[u] - rw.pos[v])
+        return wanted, moved
+
+    def _answer(self, tick: int, wanted: dict, moved: set[int]) -> None:
+        """After the moves: adoption requests and beats from the new places; the team's
+        stall verdict (rule 5)."""
+        self.radio.move(self.xy)
+        for i in self.order:
+            self._send(i, self.robots[i].after(tick, wanted.get(i), i in moved,
+                                               self.rw._around(self.radio, i, self.xy)))
+        if any(self.robots[i].tether.stalled(tick) for i in self.order):
+            self.infeasible = tick
+
+    def result(self, seed: int | None, arena: str) -> ConnectedExplorationResult:
+        rw, w, declared, paths = self.rw, self.rw.world, self.declared, self.paths
+        fields = outcome(strategy_name(self.minds), declared,
+                         () if declared is None else self.minds[declared[1]].map_edges(),
+                         None if declared is None else declared[0], paths,
+                         self.beacon_vertex, w.edges, arena=arena, root=w.root,
+                         edge_time=w.edge_time, seed=seed)
+        reason = None if self.infeasible is None else infeasible_reason(
+            len(self.minds), rw.range_m, paths, len(w.edges))
+        ticks = max(self.ticks, 1)
+        return ConnectedExplorationResult(
+            **fields, connectivity=rw.connectivity, radio_range_m=rw.range_m,
+            messages=self.radio.total_sent, connected_share=1.0 - self.cut / ticks,
+            cut_ticks=self.cut, biconnected_share=1.0 - self.fragile / ticks,
+            fragile_ticks=self.fragile,
+            relay_trips=sum(self.robots[i].relay_trips for i in self.order),
+            infeasible=self.infeasible is not None, reason=reason)
