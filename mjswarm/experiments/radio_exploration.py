@@ -1,10 +1,11 @@
 """The graph world with a radio: seed 003 exploration under a connectivity constraint.
 
-Not yet on the one loop (:mod:`mjswarm.worlds.loop`): :meth:`RadioGraphWorld.run` is
-still world, loop and loop functions in one method, because its tick has a phase the
-loop does not have (robots answer what they hear after everyone has moved, and those
-answers are delivered at the next tick's start); it lives with the experiments until it
-is split.
+Not yet on the one loop (:mod:`mjswarm.worlds.loop`): a run (``_ConnectedRun``) is
+still world, loop and ground truth in one class, because its tick has a phase the loop
+does not have: robots answer what they hear after everyone has moved, and those answers
+are delivered at the next tick's start. On the loop they would be delivered one tick
+later, and the connected-exploration results would change; it lives with the
+experiments until that is settled.
 
 Time runs in ticks of ``1 / TICKS_PER_UNIT`` time units. A robot crosses an edge in its
 duration (one time unit, or proportional to its length: ``edge_time`` as in
