@@ -76,8 +76,8 @@ def main(argv: list[str] | None = None) -> int:
         print(json.dumps(r, indent=2))
     else:
         print(f"{r['arena']}, {r['robots']} robots, {r['strategy']} (makespan {r['makespan']}): "
-              f"{r['runs_per_s_median']} runs per {'CPU' if args.cpu else 'wall'} second median, "
-              f"{r['runs_per_s_best']} best "
+              f"{r['runs_per_s_median']} runs/s median, {r['runs_per_s_best']} best "
+              f"({'CPU' if args.cpu else 'wall'} seconds) "
               f"over {args.repeats} x {r['runs_per_batch']} runs")
     return 0
 

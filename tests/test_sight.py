@@ -8,7 +8,7 @@ import pytest
 
 from mjswarm.core import sight as sight_module
 from mjswarm.core.bearing import BearingSensor
-from tests.test_raycast import arena_sims, random_state
+from test_raycast import arena_sims, random_state
 
 
 @pytest.mark.parametrize("seed", range(4))
