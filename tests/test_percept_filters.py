@@ -69,19 +69,30 @@ def test_noise_free_readings_pass_unfiltered():
     assert flt([FLOOR_M - STRIP_M, FLOOR_M, FLOOR_M]) == ((True, False, False), 0)
 
 
-def scan_spokes(spokes_deg, sigma, seed, min_width, over_read=0.0):
-    """A robot scanning in place at 1 rad/s, 50 Hz, over spokes 35 degrees wide (a 30 mm
-    strip at the sensor's 50 mm), its odometry reading ``1 + over_read`` times the turn;
-    returns the Scan when done."""
+def on_a_spoke(x, y, spokes_deg):
+    """Whether the floor point (x, y) (m, from the vertex centre) is on one of the spokes:
+    30 mm strips from 30 to 120 mm along each direction (``mjswarm.arena.geometry``)."""
+    for s in map(math.radians, spokes_deg):
+        along, across = x * math.cos(s) + y * math.sin(s), y * math.cos(s) - x * math.sin(s)
+        if abs(across) < 0.015 and 0.03 <= along <= 0.12:
+            return True
+    return False
+
+
+def scan_spokes(spokes_deg, sigma, seed, min_width, over_read=0.0, spoke_width=0.0,
+                off_m=(0.0, 0.0), direction=1):
+    """A robot scanning in place at 1 rad/s, 50 Hz, with its axle at ``off_m`` from the
+    vertex centre, over spokes 35 degrees wide (a 30 mm strip at the sensor's 50 mm), its
+    odometry reading ``1 + over_read`` times the turn; returns the Scan when done."""
     rng = np.random.default_rng(seed)
     odo = Odometry(RobotCalibration(0.025, 0.12, 0.05, 0.2))
     flt = LineFilter(FLOOR_M)
-    scan = Scan(1.0, 1, min_width)
-    half = math.degrees(math.asin(0.3))
+    scan = Scan(1.0, direction, min_width, spoke_width)
     theta = 0.0
     for _ in range(2000):
-        true = math.degrees(theta) / (1.0 + over_read)
-        on = any(abs(math.remainder(true - s, 360.0)) < half for s in spokes_deg)
+        true = theta / (1.0 + over_read)
+        on = on_a_spoke(off_m[0] + 0.05 * math.cos(true), off_m[1] + 0.05 * math.sin(true),
+                        spokes_deg)
         d = SUNK_M - (STRIP_M if on else 0.0)
         odo.theta = theta
         odo.update((0.0, 0.0))
@@ -89,7 +100,7 @@ def scan_spokes(spokes_deg, sigma, seed, min_width, over_read=0.0):
                     flt)
         if scan.step(odo, p) is None:
             return scan
-        theta += 0.02
+        theta += 0.02 * direction
     return scan
 
 
@@ -112,6 +123,35 @@ def test_an_uncalibrated_scan_that_over_reads_its_turn_still_closes_it(over_read
     scan = scan_spokes(spokes, 0.0005, 0, math.asin(0.3), over_read)
     assert scan.full_turn == pytest.approx(2 * math.pi * (1 + over_read), abs=math.radians(2))
     assert len(scan.mids) == 3
+
+
+SPOKE_WIDTH = 2.0 * math.asin(0.3)  # a 30 mm strip at the sensor's 50 mm: 35 degrees
+
+
+def test_a_scan_off_the_centre_tells_spokes_45_degrees_apart_under_noise():
+    """Issue 27, ``wheel:4@8``, 4 robots, 0.05 m/s, line noise 0.5 mm, dynamic: R1 stood
+    6 mm across its incoming spoke at ``r3`` (spokes at 53, 98 and 143 degrees), the gap
+    between the spokes at 98 and 143 degrees shrank to 4 readings under its sensor, the
+    line filter's 7 could not open it, and the scan reported one spoke at 124 degrees:
+    the robot set off between two edges and was lost, and the next robot at ``r3``
+    stopped on the beacon it wrote. Here 9.5 mm across: without ``spoke_width`` (one
+    spoke per run, as before) the scan merges them; with it, three spokes, within 2.5
+    degrees once corrected for standing off the centre (six noise seeds)."""
+    from algorithms.navigation.navigator import off_centre_correction
+
+    spokes, incoming = [53.0, 98.0, 143.0], math.radians(53.0)
+    off = (0.0095 * math.cos(incoming - math.pi / 2), 0.0095 * math.sin(incoming - math.pi / 2))
+    merged = 0
+    for seed in range(6):
+        one_per_run = scan_spokes(spokes, 0.0005, seed, SPOKE_WIDTH / 2, off_m=off,
+                                  direction=-1)
+        merged += len(one_per_run.mids) < len(spokes)
+        scan = scan_spokes(spokes, 0.0005, seed, SPOKE_WIDTH / 2, spoke_width=SPOKE_WIDTH,
+                           off_m=off, direction=-1)
+        assert scan.full_turn == pytest.approx(2 * math.pi, abs=math.radians(2))
+        found = off_centre_correction([m % (2 * math.pi) for m in scan.mids], incoming, 0.05)
+        assert [math.degrees(a) for a in found] == pytest.approx(spokes, abs=2.5)
+    assert merged >= 4  # teeth
 
 
 def test_bearing_noise_neither_triggers_nor_suppresses_the_rule():

@@ -379,16 +379,18 @@ class Navigator:
         self.state = NavigatorState.SCANNING
         self._scans += 1
         direction = 1 if self._scans % 2 else -1  # alternate: see the module docstring
-        self._plan = deque([(Scan(self.turn_rate, direction, self._spoke_min_width),
+        width = self._spoke_width
+        self._plan = deque([(Scan(self.turn_rate, direction, width / 2.0, width),
                              self._scanned)])
 
     @property
-    def _spoke_min_width(self) -> float:
-        """The narrowest run of the scan's centre sensor on a strip that counts as a
-        spoke (rad): half the angle a ``strip_width_m`` strip spans at the sensor's
-        ``line_ahead_m`` (35 degrees for the 30 mm strips at 50 mm: runs are 35 degrees
-        noise-free, a noisy flicker is a tick's 1.2 degrees)."""
-        return math.asin(self.conv.strip_width_m / 2.0 / self.cal.line_ahead_m)
+    def _spoke_width(self) -> float:
+        """The angle (rad) a ``strip_width_m`` spoke spans at the line sensor's
+        ``line_ahead_m`` around the axle: 35 degrees for the 30 mm strips at 50 mm. Runs
+        of the scan's centre sensor narrower than half of it are no spoke (a noisy
+        flicker is a tick's 1.2 degrees); runs much wider hold several
+        (:func:`~.motions.spokes_in_run`)."""
+        return 2.0 * math.asin(self.conv.strip_width_m / 2.0 / self.cal.line_ahead_m)
 
     def _scanned(self, scan: Scan) -> None:
         """Calibrate, then turn the scan's crossings into incidence angles."""
