@@ -347,7 +347,8 @@ class Navigator:
 
     def _lane_ended(self, lane: FollowLine) -> None:
         if not self.vertex_detected and not self._returning:
-            self._lose("lane ended with the wall still beside the robot")
+            self._lose("lane ended with the wall still beside the robot" if self._wall_seen
+                       else "lane ended before any corridor wall was seen (not its lane?)")
             return
         self.state = NavigatorState.ARRIVING
         heading = lane.direction(self.odometry.theta, last=None)
