@@ -67,10 +67,18 @@ class Noise:
 
 
 #: Issue 27's noise levels: each at its largest alone, then all together.
-NOISES = (
-    Noise(line_m=0.0005), Noise(ir_m=0.002), Noise(bearing_deg=2.0), Noise(wheel_slip=0.05),
-    Noise(line_m=0.0005, ir_m=0.002, bearing_deg=2.0, wheel_slip=0.05),
-)
+#: The wheel slip the noise grid asks for (issue 27).
+GRID_SLIP = 0.05
+
+
+def noises(slip: float = GRID_SLIP) -> tuple[Noise, ...]:
+    """The noise grid's levels, each alone and all together, with wheel slip ``slip``."""
+    return (Noise(line_m=0.0005), Noise(ir_m=0.002), Noise(bearing_deg=2.0),
+            Noise(wheel_slip=slip),
+            Noise(line_m=0.0005, ir_m=0.002, bearing_deg=2.0, wheel_slip=slip))
+
+
+NOISES = noises()
 #: The noise grid's arena classes: one of each kind of the grid above (fan, wheel, hex,
 #: triangular, rotated lattice, paper arena, random planar), teams of 1 and 4.
 NOISE_ARENAS = ("fan:3:45@17", "wheel:4@8", "hex:2x2@30", "tri:2x3@7", "lattice:4x4@33",
@@ -216,16 +224,25 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sample", action="store_true",
                         help="with --noise: only 0.05 and 0.2 m/s, teams of 4 and one seed "
                              "(140 runs)")
+    parser.add_argument("--slip", type=float, default=GRID_SLIP, metavar="S",
+                        help=f"with --noise: the wheel slip of its slip levels (default "
+                             f"{GRID_SLIP:g})")
+    parser.add_argument("--only-slip", action="store_true",
+                        help="with --noise: only the levels with wheel slip (alone, and "
+                             "with every noise together)")
     args = parser.parse_args(argv)
-    if args.sample and not args.noise:
-        parser.error("--sample needs --noise")
+    if (args.sample or args.only_slip or args.slip != GRID_SLIP) and not args.noise:
+        parser.error("--sample, --slip and --only-slip need --noise")
+    if not 0.0 <= args.slip < 1.0:
+        parser.error(f"--slip must be in [0, 1), got {args.slip:g}")
     if args.noise:
         arenas = NOISE_ARENAS if args.arenas is None else args.arenas.split(",")
+        levels = tuple(n for n in noises(args.slip) if n.wheel_slip or not args.only_slip)
         if args.sample:
             runs = noise_grid(arenas=arenas, speeds=SAMPLE_SPEEDS_M_S, teams=SAMPLE_TEAMS,
-                              seeds=range(args.seeds or 1))
+                              noises=levels, seeds=range(args.seeds or 1))
         else:
-            runs = noise_grid(arenas=arenas, seeds=range(args.seeds or 2))
+            runs = noise_grid(arenas=arenas, noises=levels, seeds=range(args.seeds or 2))
         heading = MAX_HEADING_ERROR_DEG
     else:
         arenas = ARENAS if args.arenas is None else args.arenas.split(",")
