@@ -86,8 +86,8 @@ def run_embodied(args) -> dict:
                 result = run_exploration(
                     spec, args.robots, args.strategy, world="embodied", seed=args.seed,
                     max_time=args.max_time, radio_range_m=args.radio_range,
-                    connectivity=args.connectivity, config=config, recorder=recording,
-                    functions=[video] if video is not None else [], progress=True)
+                    connectivity=args.connectivity, config=config,
+                    functions=[f for f in (recording, video) if f is not None], progress=True)
             except RunInterrupted as stop:  # the outputs keep their partial contents
                 stop.result = _embodied_dict(stop.result, args)
                 raise

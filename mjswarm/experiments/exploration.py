@@ -78,7 +78,7 @@ from __future__ import annotations
 import math
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from tqdm import tqdm
@@ -136,11 +136,12 @@ BUILD_NOTE_S = 2.0
 
 class EmbodiedExploration(LoopFunctions):
     """One embodied exploration run: build the world and the robots, compose the loop
-    functions, run, and the result. ``recorder``: a loop function that records the run
-    (:class:`mjswarm.outputs.exploration_recording.ExplorationRecording`), or None."""
+    functions, run, and the result. ``functions``: more loop functions that watch the run
+    (a recording, :class:`mjswarm.outputs.exploration_recording.ExplorationRecording`; a
+    video), added after the experiment's own."""
 
     def __init__(self, spec: ArenaSpec, minds: list[Strategy], config: EmbodiedConfig,
-                 seed: int | None = None, recorder: LoopFunctions | None = None,
+                 seed: int | None = None, functions: Sequence[LoopFunctions] = (),
                  progress: bool = False) -> None:
         """Check every parameter, then build the world (``progress``: say on stderr what
         is being built, and how long it took: a thousand robots take seconds)."""
@@ -159,9 +160,7 @@ class EmbodiedExploration(LoopFunctions):
             controllers[BASE] = FixedNode(BaseStation(Flooder()))
         for i in self.world.docked:  # rule 1: the first robot docks at the base
             controllers[i] = FixedNode(docked(Flooder()))
-        self.loop = Loop(self.world, controllers, self._functions(order))
-        if recorder is not None:
-            self.loop.add(recorder)
+        self.loop = Loop(self.world, controllers, [*self._functions(order), *functions])
         took = time.perf_counter() - built
         if terminal:
             print("\033[K", end="", file=sys.stderr, flush=True)
@@ -349,11 +348,12 @@ class EmbodiedExploration(LoopFunctions):
 def explore_embodied(spec: ArenaSpec, n_robots: int,
                      strategy: str | Callable[..., Strategy] = "incidence-dfs",
                      config: EmbodiedConfig | None = None, seed: int | None = None,
-                     recorder: LoopFunctions | None = None,
+                     functions: Sequence[LoopFunctions] = (),
                      progress: bool = False) -> EmbodiedResult:
     """Explore ``spec`` with ``n_robots`` embodied robots running ``strategy`` (a name
-    from ``STRATEGIES`` or a factory ``(index, n_robots, rng) -> Strategy``);
-    ``recorder``: a loop function that records the run."""
+    from ``STRATEGIES`` or a factory ``(index, n_robots, rng) -> Strategy``), watched by
+    ``functions`` (a recording, a video)."""
     minds = make_minds(strategy, n_robots, seed)
-    run = EmbodiedExploration(spec, minds, config or EmbodiedConfig(), seed, recorder)
+    run = EmbodiedExploration(spec, minds, config or EmbodiedConfig(), seed, functions,
+                              progress=progress)
     return run.run(progress=progress)

@@ -34,7 +34,7 @@ def run_exploration(spec: ArenaSpec, robots: int,
                     world: str = "graph", seed: int | None = None,
                     max_time: float | None = None, edge_time: str = "unit",
                     radio_range_m: float | None = None, connectivity: str | None = None,
-                    config=None, functions: Sequence[LoopFunctions] = (), recorder=None,
+                    config=None, functions: Sequence[LoopFunctions] = (),
                     progress: bool = False) -> ExplorationResult:
     """Explore ``spec`` from its root with ``robots`` robots running ``strategy`` (a
     name from ``STRATEGIES`` or a factory) in ``world``.
@@ -44,26 +44,22 @@ def run_exploration(spec: ArenaSpec, robots: int,
     ``connectivity``: a radio, and the constraint to keep; ``config``: the embodied run's
     :class:`~mjswarm.experiments.exploration.EmbodiedConfig` (its radio, constraint and
     time limit are set from the arguments above when given); ``functions``: more loop
-    functions (a video; not in the radio graph world, which is not on the loop yet);
-    ``recorder``: a loop function that records an embodied run
-    (:class:`~mjswarm.outputs.exploration_recording.ExplorationRecording`); ``progress``: a progress display
-    (embodied world).
+    functions that watch the run (a recording, e.g. :class:`~mjswarm.outputs.
+    exploration_recording.ExplorationRecording`, a video; not in the radio graph world,
+    which is not on the loop yet); ``progress``: a progress display (embodied world).
     """
     if world not in WORLDS:
         raise MjswarmError(f"unknown world '{world}' (choose from {', '.join(WORLDS)})")
-    minds = make_minds(strategy, robots, seed)
     if world == "embodied":
-        from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
+        from mjswarm.experiments.exploration import EmbodiedConfig, explore_embodied
 
         config = config or EmbodiedConfig()
         config = replace(
             config, connectivity=connectivity or config.connectivity,
             radio_range_m=config.radio_range_m if radio_range_m is None else radio_range_m,
             max_sim_time_s=config.max_sim_time_s if max_time is None else max_time)
-        run = EmbodiedExploration(spec, minds, config, seed, recorder, progress=progress)
-        for function in functions:
-            run.loop.add(function)
-        return run.run(progress=progress)
+        return explore_embodied(spec, robots, strategy, config, seed, functions, progress)
+    minds = make_minds(strategy, robots, seed)
     from mjswarm.worlds.graphworld import GraphWorld
 
     graph = GraphWorld(spec.graph(), spec.root, edge_time=edge_time)

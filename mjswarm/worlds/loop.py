@@ -257,7 +257,9 @@ class Loop:
         self.halted: set[int] = set()
         self.stepped: list = []
         self.reports: list[tuple[Any, Any]] = []
-        self._perceive = False  # whether a controller has a perceive() of its own
+        #: whether any controller (a robot's or a fixed node's) has a perceive() of its own
+        self._perceive = any(type(c).perceive is not Controller.perceive
+                             for c in self.controllers.values())
         self._on_floor: set = set()  # robots reset since they last entered the floor
         self._stop = False
         for f in functions:
@@ -332,7 +334,6 @@ class Loop:
             if i not in on_floor:
                 self.controllers[i].reset()
                 on_floor.add(i)
-                self._perceive |= type(self.controllers[i]).perceive is not Controller.perceive
 
     def run(self, max_ticks: int | None = None,
             on_tick: Callable[[Loop], None] | None = None) -> list[Any]:
