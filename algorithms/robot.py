@@ -17,7 +17,8 @@ robot could have in that tick:
   knowledge, seed 004's MANET layer);
 * the beacon handle of the vertex whose centre it stands on, else None;
 * in the graph worlds, where robots have no bodies, what a scan of that vertex would
-  measure (:class:`VertexSense`).
+  measure (:class:`VertexSense`), and in the radio graph world what its odometer and
+  range-and-bearing radio tell it of its leg and its neighbours (:class:`LegSense`).
 
 It never holds another robot's pose, the arena graph or the contact list:
 ``tests/test_robot_type.py`` pins the field list. One :class:`Message` type carries
@@ -60,6 +61,34 @@ class VertexSense(NamedTuple):
     arrived_by_rad: float | None
 
 
+class LegSense(NamedTuple):
+    """What a robot of the radio graph world senses of its motion and of its radio
+    neighbours in one tick (perfect sensors: it has no body, and no heading).
+
+    The world moves a robot along an edge at the edge's own speed (one edge per its
+    duration), so what a step will be is the robot's motion model, which it knows as a
+    real robot knows its speed; the tether (:mod:`algorithms.exploration.tether`, rule 3)
+    judges a step by it before the robot takes it.
+
+    Attributes:
+        progress: the share of the edge it walks that is behind it (its odometry in the
+            world's measure; 0 at the start of a leg, 1 at its end).
+        steps_m: on an edge, one tick's displacement on along it and back (m, x and y);
+            None when it stands at a vertex.
+        exits_m: at a vertex call, the same pair for the first tick along each edge
+            there, by incidence angle (rad); empty otherwise.
+        around_m: each radio neighbour's displacement from it (m, x and y).
+        answering: whether this is the tick's answer phase: every robot has moved, and
+            it may speak from its new place (the world's docstring).
+    """
+
+    progress: float
+    steps_m: tuple[tuple[float, float], tuple[float, float]] | None
+    exits_m: Mapping[float, tuple[tuple[float, float], tuple[float, float]]]
+    around_m: Mapping[Hashable, tuple[float, float]]
+    answering: bool
+
+
 #: An empty, read-only mapping (the default of the observation's mappings).
 NOTHING: Mapping = MappingProxyType({})
 
@@ -83,6 +112,7 @@ class Observation(NamedTuple):
         neighbors: ids the radio hears this tick.
         beacon: the beacon of the vertex whose centre the robot stands on, else None.
         vertex: in a graph world, at a vertex call, what it senses of the vertex.
+        leg: in the radio graph world, what it senses of its leg and its neighbours.
     """
 
     robot: Hashable
@@ -99,6 +129,7 @@ class Observation(NamedTuple):
     neighbors: frozenset = frozenset()
     beacon: Any = None
     vertex: VertexSense | None = None
+    leg: LegSense | None = None
 
 
 class Command(NamedTuple):

@@ -2,7 +2,7 @@
 
 For each arena, team size K and radio range R (m), one run per constraint (``none``,
 ``connected``, ``biconnected``; seed 003's incidence-DFS, canonical tie rules) in
-:class:`~mjswarm.experiments.radio_exploration.RadioGraphWorld`; prints a markdown table: makespan
+:class:`~mjswarm.worlds.radiograph.RadioGraphWorld`; prints a markdown table: makespan
 (time units, or the verdict), total traversals, radio messages and relay trips, with
 the unconstrained run's shares of ticks in which every robot reached the base and the
 team with the base was biconnected (ground truth; the constrained runs hold theirs in

@@ -20,8 +20,8 @@ from algorithms.exploration import STRATEGIES
 from mjswarm.arena import load_arena
 from mjswarm.experiments.graph_exploration import explore_world
 from mjswarm.experiments.minds import make_minds
+from mjswarm.experiments.radio_exploration import run_connected
 from mjswarm.worlds.graphworld import GraphWorld
-from mjswarm.experiments.radio_exploration import RadioGraphWorld
 
 ARENAS = ("fig9", "arena1", "arena2", "tree1", "tree2", "tree3", "tree4", "lattice:4x4",
           "lattice:3x5", "random-tree:14:1", "random-tree:20:2", "random-graph:12:16:3",
@@ -48,8 +48,8 @@ def radio_runs():
         spec = load_arena(arena)
         world = GraphWorld(spec.graph(), spec.root)
         for k, seed in itertools.product((2, 3, 5), (None, 0, 1)):
-            radio = RadioGraphWorld(world, range_m, connectivity)
-            result = radio.run(make_minds("incidence-dfs", k, seed), seed=seed, arena=arena)
+            result = run_connected(world, make_minds("incidence-dfs", k, seed), range_m,
+                                   connectivity, seed=seed, arena=arena)
             yield {"world": "radio-graph", "range": range_m, **result.to_dict()}
 
 

@@ -18,15 +18,16 @@ from mjswarm.cli import main
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.minds import make_minds
 from mjswarm.worlds.graphworld import GraphWorld
-from mjswarm.experiments.radio_exploration import TICKS_PER_UNIT, RadioGraphWorld
+from mjswarm.experiments.radio_exploration import run_connected
+from mjswarm.worlds.radiograph import TICKS_PER_UNIT
 
 
 def run(arena: str, robots: int, range_m: float, connectivity: str = "connected",
         strategy: str = "incidence-dfs", seed: int | None = None):
     spec = load_arena(arena)
     world = GraphWorld(spec.graph(), spec.root)
-    radio = RadioGraphWorld(world, range_m, connectivity)
-    return radio.run(make_minds(strategy, robots, seed), seed=seed, arena=arena), world
+    return run_connected(world, make_minds(strategy, robots, seed), range_m, connectivity,
+                         seed=seed, arena=arena), world
 
 
 CASES = [(f"random-graph:{v}:{e}:{s}", k, r)
@@ -296,7 +297,8 @@ def test_cli_bad_input_is_one_line(capsys, argv, message):
 def test_bad_connectivity_is_one_clear_error():
     spec = load_arena("fig9")
     with pytest.raises(MjswarmError, match="connectivity must be one of none, connected, biconnected"):
-        RadioGraphWorld(GraphWorld(spec.graph(), spec.root), 1.0, "triconnected")
+        run_connected(GraphWorld(spec.graph(), spec.root), make_minds("incidence-dfs", 2), 1.0,
+                      "triconnected")
 
 
 def test_the_readme_table_script_runs():

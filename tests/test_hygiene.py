@@ -132,6 +132,18 @@ def test_graph_world_exploration_hands_out_nothing_forbidden(watched):
     _clean(watched)
 
 
+@pytest.mark.parametrize("connectivity", ["connected", "biconnected"])
+def test_radio_graph_world_exploration_hands_out_nothing_forbidden(watched, connectivity):
+    """Tethered robots, relays, the base and the docked robot on the loop: observations
+    and delivered messages hold values only (a relay request names a leg by beacon id)."""
+    from mjswarm.experiments.runs import run_exploration
+
+    result = run_exploration(load_arena("lattice:4x4"), 5, world="graph", seed=0,
+                             radio_range_m=1.3, connectivity=connectivity)
+    assert result.messages > 0 and (result.completed or result.infeasible)
+    _clean(watched, 1000)
+
+
 def test_old_beacon_handles_raise_in_the_graph_world():
     """A controller that keeps its handle finds it dead at its next call."""
     from mjswarm.worlds.graphworld import GraphWorld

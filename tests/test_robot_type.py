@@ -22,7 +22,7 @@ from mjswarm.worlds.sparkworld import SparkWorld
 #: added here must be something a real robot could have (algorithms/robot.py).
 ALLOWED_FIELDS = ("robot", "time_s", "line_m", "ir_m", "encoder_rad", "wheel_speed_rad_s",
                   "battery_v", "pose", "bearings", "detections", "inbox", "neighbors",
-                  "beacon", "vertex")
+                  "beacon", "vertex", "leg")
 
 
 def test_an_observation_holds_only_what_a_robot_could_sense():

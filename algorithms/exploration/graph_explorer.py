@@ -7,12 +7,19 @@ is a command: ``edge_rad`` to leave along an edge, nothing to idle, a
 :class:`~algorithms.exploration.events.Declared` event to declare completion. The
 strategy is the same object that runs inside the embodied
 :class:`~algorithms.exploration.explorer.Explorer`.
+
+In the radio graph world (:mod:`mjswarm.worlds.radiograph`) a robot explores on a tether,
+with relays on demand: :class:`TetheredExplorer` runs a
+:class:`~algorithms.exploration.relay.ConnectedExplorer` in that world's two phases.
 """
 
 from __future__ import annotations
 
-from algorithms.exploration.base import Strategy
-from algorithms.exploration.events import Declared
+from collections.abc import Mapping
+
+from algorithms.exploration.base import Strategy, angle_gap
+from algorithms.exploration.events import Declared, Infeasible
+from algorithms.exploration.relay import ConnectedExplorer
 from algorithms.robot import STOP, Command, Controller, Observation
 
 
@@ -55,3 +62,88 @@ def graph_explorer(strategy: Strategy) -> GraphExplorer:
     """The controller that runs ``strategy`` in a graph world."""
     keeps_books = type(strategy).arrive is not Strategy.arrive
     return (BookkeepingExplorer if keeps_books else GraphExplorer)(strategy)
+
+
+class TetheredExplorer(Controller):
+    """A :class:`~algorithms.exploration.relay.ConnectedExplorer` as the controller of a
+    robot in the radio graph world, whose ticks have a move phase and an answer phase
+    (:class:`~algorithms.robot.LegSense`'s ``answering``).
+
+    Move phase: :meth:`perceive` reads the radio (``hear``) and, at a vertex call, does
+    the arrival's bookkeeping (``arrive``: every robot of the tick before any decides);
+    :meth:`step` decides at a vertex call (``on_vertex``), then on an edge (or leaving
+    one) asks ``direction`` and, for the step, the tether's ``may_step`` (rule 3), and
+    answers with what it heard to send on. Answer phase: a walk back that reached the
+    vertex is told (``arrived_back``), then ``after`` (adoption requests, beats) and rule
+    5's verdict, reported as :class:`~algorithms.exploration.events.Infeasible`. With
+    ``constrained`` False (no constraint to keep) it only walks its strategy: it never
+    hears, waits or speaks.
+    """
+
+    def __init__(self, connected: ConnectedExplorer, constrained: bool = True) -> None:
+        self.connected = connected
+        self.constrained = constrained
+        self._ticks_per_unit = connected.tether.ticks_per_unit
+        self._out: list = []  # what it heard to send on
+        self._wanted = None  # the step the tether forbade it in this tick's move phase
+        self._moved = self._back = False
+
+    def telemetry(self) -> Mapping[str, float]:
+        """``relay_trips``: relay missions it set out on (rule 6)."""
+        return {"relay_trips": self.connected.relay_trips}
+
+    def perceive(self, observation: Observation) -> None:
+        if observation.leg.answering:
+            return
+        c, vertex = self.connected, observation.vertex
+        if self.constrained:
+            self._out = c.hear(self._tick(observation), observation.inbox,
+                               observation.leg.around_m)
+        if vertex is not None:
+            c.arrive(observation.beacon, vertex.angles_rad, vertex.arrived_by_rad)
+
+    def step(self, observation: Observation) -> Command:
+        if observation.leg.answering:
+            return self._answer(observation) if self.constrained else STOP
+        return self._move(observation)
+
+    def _tick(self, observation: Observation) -> int:
+        return round(observation.time_s * self._ticks_per_unit)
+
+    def _move(self, observation: Observation) -> Command:
+        c, leg, vertex = self.connected, observation.leg, observation.vertex
+        out, self._out = tuple(self._out), []
+        self._wanted, self._moved, self._back = None, False, False
+        steps, progress, edge_rad = leg.steps_m, leg.progress, None
+        if vertex is not None:
+            decision = c.on_vertex(observation.beacon, vertex.angles_rad, vertex.arrived_by_rad)
+            if decision.action == "done":
+                return Command(messages=out, events=(Declared(tuple(c.mind.map_edges())),))
+            if decision.action == "idle":
+                return Command(messages=out)
+            if decision.action != "go":
+                raise ValueError(f"robot {c.index + 1} answered an unknown decision "
+                                 f"{decision!r}")
+            edge_rad, progress = decision.angle, 0.0
+            steps = _nearest(leg.exits_m, decision.angle)
+        if steps is None:  # standing at a vertex between calls
+            return Command(messages=out)
+        sense = c.direction(progress) if self.constrained else 1
+        if sense and self.constrained and not c.tether.may_step(steps[sense < 0], leg.around_m):
+            self._wanted, sense = steps[sense < 0], 0
+        self._moved, self._back = sense != 0, sense < 0
+        return Command(float(sense), 0.0, None, out, None, edge_rad)
+
+    def _answer(self, observation: Observation) -> Command:
+        c, leg, tick = self.connected, observation.leg, self._tick(observation)
+        if self._back and leg.steps_m is None:  # the walk back reached the vertex
+            c.arrived_back()
+        out = c.after(tick, self._wanted, self._moved, leg.around_m)
+        events = (Infeasible(),) if c.tether.stalled(tick) else ()
+        return Command(messages=tuple(out), events=events)
+
+
+def _nearest(exits: Mapping, angle: float):
+    """The entry of ``exits`` (by incidence angle, rad) nearest to ``angle``."""
+    found = exits.get(angle)
+    return found if found is not None else exits[min(exits, key=lambda a: angle_gap(a, angle))]

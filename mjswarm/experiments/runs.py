@@ -45,8 +45,7 @@ def run_exploration(spec: ArenaSpec, robots: int,
     :class:`~mjswarm.experiments.exploration.EmbodiedConfig` (its radio, constraint and
     time limit are set from the arguments above when given); ``functions``: more loop
     functions that watch the run (a recording, e.g. :class:`~mjswarm.outputs.
-    exploration_recording.ExplorationRecording`, a video; not in the radio graph world,
-    which is not on the loop yet); ``progress``: a progress display (embodied world).
+    exploration_recording.ExplorationRecording`, a video); ``progress``: a progress display (embodied world).
     """
     if world not in WORLDS:
         raise MjswarmError(f"unknown world '{world}' (choose from {', '.join(WORLDS)})")
@@ -68,9 +67,7 @@ def run_exploration(spec: ArenaSpec, robots: int,
 
         return run_minds(graph, minds, seed=seed, max_time=max_time, arena=spec.name,
                          functions=functions)
-    from mjswarm.experiments.radio_exploration import RadioGraphWorld
+    from mjswarm.experiments.radio_exploration import run_connected
 
-    if functions:
-        raise MjswarmError("the graph world with a radio takes no loop functions yet")
-    return RadioGraphWorld(graph, radio_range_m, connectivity or "none").run(
-        minds, seed=seed, max_time=max_time, arena=spec.name)
+    return run_connected(graph, minds, radio_range_m, connectivity or "none", seed=seed,
+                         max_time=max_time, arena=spec.name, functions=functions)
