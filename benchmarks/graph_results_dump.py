@@ -1,13 +1,14 @@
 """Dump the graph worlds' results on a large grid, to check that a change to the graph
 worlds or the loop leaves them identical (issue 28).
 
-    python benchmarks/graph_results_dump.py OUT.jsonl      # about a minute on 2 cores
+    python benchmarks/graph_results_dump.py OUT.jsonl      # about 2 minutes on 2 cores
     python benchmarks/graph_results_dump.py NEW.jsonl && cmp OLD.jsonl NEW.jsonl
 
 Every line is one run's full result (JSON, keys sorted): the graph world for every
 shipped strategy on paper arenas, lattices, random trees, graphs and planar graphs, with
 1 to 8 robots, canonical tie rules and three seeds, unit and length edge times; and the
-radio graph world under each connectivity constraint at two ranges.
+radio graph world (1728 runs) under each connectivity constraint, at two ranges, both edge
+times, 2 to 6 robots.
 """
 
 from __future__ import annotations
@@ -28,8 +29,10 @@ ARENAS = ("fig9", "arena1", "arena2", "tree1", "tree2", "tree3", "tree4", "latti
           "random-planar:12:4", "hex:2x2", "wheel:6")
 ROBOTS = (1, 2, 3, 4, 6, 8)
 SEEDS = (None, 0, 1, 2)
-RADIO = (("lattice:4x4", 1.3), ("arena2", 1.0), ("random-graph:12:16:3", 1.5),
-         ("tree2", 1.2))
+#: the radio graph world's arenas and a radio range for each (m); every run also at twice it
+RADIO = (("lattice:4x4", 1.3), ("arena2", 1.0), ("random-graph:12:16:3", 1.5), ("tree2", 1.2),
+         ("arena1", 0.8), ("fig9", 1.0), ("lattice:3x5", 0.9), ("random-tree:14:1", 1.1),
+         ("random-planar:12:4", 1.0), ("hex:2x2", 0.7), ("tree4", 0.6), ("wheel:6", 0.9))
 
 
 def graph_runs():
@@ -43,14 +46,14 @@ def graph_runs():
 
 
 def radio_runs():
-    for (arena, range_m), connectivity in itertools.product(RADIO, ("none", "connected",
-                                                                      "biconnected")):
+    for (arena, range_m), connectivity, edge_time in itertools.product(
+            RADIO, ("none", "connected", "biconnected"), ("unit", "length")):
         spec = load_arena(arena)
-        world = GraphWorld(spec.graph(), spec.root)
-        for k, seed in itertools.product((2, 3, 5), (None, 0, 1)):
-            result = run_connected(world, make_minds("incidence-dfs", k, seed), range_m,
+        world = GraphWorld(spec.graph(), spec.root, edge_time=edge_time)
+        for k, seed, scale in itertools.product((2, 3, 4, 6), (None, 0, 1), (1, 2)):
+            result = run_connected(world, make_minds("incidence-dfs", k, seed), scale * range_m,
                                    connectivity, seed=seed, arena=arena)
-            yield {"world": "radio-graph", "range": range_m, **result.to_dict()}
+            yield {"world": "radio-graph", "range": scale * range_m, **result.to_dict()}
 
 
 def main(path: str) -> None:
