@@ -155,3 +155,18 @@ def test_a_users_controller_runs_in_the_graph_world():
     assert result.completed and result.makespan == 4 and result.declared_by == 2
     assert result.paths[0] == result.paths[1] and len(result.paths[0]) == 5
     assert not result.map_correct  # an empty map
+
+
+def test_a_vertex_call_is_the_observation_built_by_name():
+    """The graph world builds its observations as tuples (a call per decision): each is
+    field for field the observation the named constructor gives."""
+    from algorithms.robot import Observation, VertexSense
+
+    g = fig9()
+    root = next(iter(g))
+    world = GraphWorld(g, root)
+    world.reset(2)
+    o = world.observe(1)
+    expected = Observation(1, 0, beacon=o.beacon, vertex=VertexSense(world.angles[root], None))
+    assert type(o) is Observation and len(o) == len(Observation._fields)
+    assert o == expected and o.vertex == expected.vertex and o.leg is None

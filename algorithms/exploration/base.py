@@ -84,43 +84,54 @@ class ExpiredBeacon(RuntimeError):
     """A beacon handle was used after the tick it was handed out in."""
 
 
+class _Expired:
+    """What an expired :class:`BeaconHandle` holds instead of its beacon: any use raises."""
+
+    __slots__ = ()
+
+    def _raise(self, *_):
+        raise ExpiredBeacon("a beacon handle is good only during the tick it was handed out "
+                            "in; keep its id instead")
+
+    __getattr__ = __setattr__ = _raise
+
+
+_EXPIRED = _Expired()
+
+
 class BeaconHandle:
     """What a world hands a robot of the beacon it stands on: reads and writes go to the
     vertex's :class:`Beacon` during the tick it was handed out in; afterwards (the world
     calls :meth:`expire` when it steps) any use raises :class:`ExpiredBeacon`. A robot
-    that wants to remember a vertex keeps its ``id``, never the handle."""
+    that wants to remember a vertex keeps its ``id``, never the handle.
+
+    A decision reads and writes its beacon a few times, in every world, so the accessors
+    are one attribute hop: expiring swaps the beacon for an object that raises."""
 
     __slots__ = ("_beacon",)
 
     def __init__(self, beacon: Beacon) -> None:
         self._beacon = beacon
 
-    def _live(self) -> Beacon:
-        beacon = self._beacon
-        if beacon is None:
-            raise ExpiredBeacon("a beacon handle is good only during the tick it was "
-                                "handed out in; keep its id instead")
-        return beacon
-
     @property
     def id(self) -> str | None:
-        return self._live().id
+        return self._beacon.id
 
     @id.setter
     def id(self, value: str | None) -> None:
-        self._live().id = value
+        self._beacon.id = value
 
     @property
     def data(self) -> Any:
-        return self._live().data
+        return self._beacon.data
 
     @data.setter
     def data(self, value: Any) -> None:
-        self._live().data = value
+        self._beacon.data = value
 
     def expire(self) -> None:
         """The tick is over: the handle no longer reaches the beacon."""
-        self._beacon = None
+        self._beacon = _EXPIRED
 
 
 class Strategy(ABC):

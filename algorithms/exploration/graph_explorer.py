@@ -30,6 +30,7 @@ class GraphExplorer(Controller):
 
     def __init__(self, strategy: Strategy) -> None:
         self.strategy = strategy
+        self._go: dict[float, Command] = {}  # by angle: a command per decision, made once
 
     def step(self, observation: Observation) -> Command:
         vertex = observation.vertex
@@ -37,8 +38,11 @@ class GraphExplorer(Controller):
             return STOP
         decision = self.strategy.on_vertex(observation.beacon, vertex.angles_rad,
                                            vertex.arrived_by_rad)
-        if decision.action == "go":  # positional: a call per decision
-            return Command(0.0, 0.0, None, (), None, decision.angle)
+        if decision.action == "go":
+            command = self._go.get(decision.angle)
+            if command is None:
+                command = self._go[decision.angle] = Command(edge_rad=decision.angle)
+            return command
         if decision.action == "done":
             return Command(events=(Declared(tuple(self.strategy.map_edges())),))
         if decision.action == "idle":

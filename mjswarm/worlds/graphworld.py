@@ -39,6 +39,8 @@ from mjswarm.errors import MjswarmError
 from mjswarm.worlds.loop import World
 
 EDGE_TIMES = ("unit", "length")
+_observation = tuple.__new__
+_NOBODY = frozenset()
 
 
 class GraphWorld(World):
@@ -98,6 +100,8 @@ class GraphWorld(World):
         for (v, a), u in self.towards.items():
             self._exits[v][a] = (u, self.duration[(v, u)], self.angle_of[(u, v)])
         self.uplinks = {}
+        #: (vertex, angle arrived by) -> what a robot senses there, made once
+        self._senses: dict[tuple[str, float | None], VertexSense] = {}
         self.reset(0)
 
     def reset(self, n_robots: int) -> None:
@@ -138,13 +142,23 @@ class GraphWorld(World):
     def active(self) -> list[int]:
         return self._batch
 
+    def on_floor(self, i) -> bool:
+        return True  # every robot is in the graph from start to end
+
+    def robots_on_floor(self) -> int:
+        return self.n
+
     def observe(self, i: int) -> Observation:
-        v = self.at[i]  # positional: a call per decision, twice as fast as by keyword
+        v, arrived_by = self.at[i], self._arrived_by[i]
         handle = BeaconHandle(self.beacons[v])
         self._handles.append(handle)
-        return Observation(i, self._now, None, None, None, None, None, None, NOTHING, NOTHING,
-                           (), frozenset(), handle,
-                           VertexSense(self.angles[v], self._arrived_by[i]))
+        sense = self._senses.get((v, arrived_by))
+        if sense is None:
+            sense = self._senses[(v, arrived_by)] = VertexSense(self.angles[v], arrived_by)
+        # an observation per decision: built as the tuple it is (the named constructor
+        # costs a Python call more; tests/test_graph_world.py checks the fields)
+        return _observation(Observation, (i, self._now, None, None, None, None, None, None,
+                                          NOTHING, NOTHING, (), _NOBODY, handle, sense, None))
 
     def act(self, i: int, command: Command) -> None:
         """Leave along ``command.edge_rad`` (the nearest edge), or idle one time unit."""
