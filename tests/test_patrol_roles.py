@@ -30,8 +30,7 @@ def _state(role, x, degree):
 
 
 def _leader(parent_role=Role.REPEATER, parent_at=(0.0, 0.0)):
-    ll = RoleSwitchingRobot(1, Role.LOCAL_LEADER, P, parent=0)
-    ll.connections = {0}
+    ll = RoleSwitchingRobot(1, Role.LOCAL_LEADER, P, parent=0, connections={0})
     return ll, {0: Detected(np.array(parent_at), parent_role)}
 
 
