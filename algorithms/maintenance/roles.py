@@ -34,8 +34,13 @@ Choices where the paper is silent (all parameters are in :class:`RoleParams`):
 * Positions of other robots come from detection (current), their ``u_j`` and ``|A_j|``
   from their last state (one step old). Detection also tells the role (the paper's
   recovery needs to recognise repeaters and the base station).
+* Targets (Sect. IV-B: "the simulator informs the base station"): the base station
+  starts with its first target and is sent the next ones as :class:`Target` messages by
+  the experimenter; it keeps them in order and, as soon as it hears that the local leader
+  reached its current target, reports :class:`TargetReached` and takes the next (the
+  experimenter keeps one ahead, so the switch does not wait for a message).
 * What the experimenter learns of a robot comes from its events (``Command.events``:
-  :class:`Connections` whenever ``A_i`` changes), the role it shows
+  :class:`TargetReached`, :class:`Connections` whenever ``A_i`` changes), the role it shows
   (``Command.signal``) and :meth:`RoleSwitchingRobot.telemetry`, never its attributes.
 * Role requests (:class:`Lead`) and (dis)connection requests are messages to one robot.
   A local leader that must become a repeater but has no explorer within reach to hand
@@ -56,6 +61,7 @@ from __future__ import annotations
 import enum
 import math
 import time
+from collections import deque
 from collections.abc import Hashable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -141,6 +147,13 @@ class State(NamedTuple):
     arrived: int
 
 
+class TargetReached(NamedTuple):
+    """Event of the base station (``Command.events``): it heard that the local leader
+    reached target ``seq`` (Sect. IV-B's cue for the next target)."""
+
+    seq: int
+
+
 class Connections(NamedTuple):
     """Event of any robot (``Command.events``): its connections ``A_i`` now, reported in
     the tick they change (and in its first tick); the experimenter's network metric."""
@@ -198,7 +211,7 @@ class RoleSwitchingRobot(Controller):
         parent, child: initial parent / child ids (repeaters, local leader, base station).
         connections: its initial connections ``A_i`` (the deployment's base station -
             local leader link).
-        target: the base station's first :class:`Target`.
+        target: the base station's first :class:`Target` (the next ones come as messages).
         every_step_aat: run the Acute Angle Test on every candidate every step (the
             baseline) instead of Algorithm 2.
         step_s: the duration of one timestep (s), the control period.
@@ -219,6 +232,7 @@ class RoleSwitchingRobot(Controller):
         self.leader: LeaderInfo | None = None
         self.target = target
         self.arrived = -1
+        self._targets: deque[Target] = deque()  # the base station's next targets
         self._events: list = []  # this tick's events
         self._reported: frozenset | None = None  # A_i as last reported
         self.u = np.zeros(2)
@@ -283,10 +297,22 @@ class RoleSwitchingRobot(Controller):
                       self.leader, self.target, self.arrived)
         out.extend((j, state) for j in sorted(self.connections))
         self._previous_role = self.role
+        if self.role is Role.BASE_STATION:
+            self._next_target()
         if self.connections != self._reported:
             self._reported = frozenset(self.connections)
             self._events.append(Connections(self._reported))
         return self.u, out
+
+    def _next_target(self) -> None:
+        """The base station, after its state went out: once it has heard that the local
+        leader reached its target (Sect. IV-B), report it and take the next target it
+        was sent (none until one comes)."""
+        if self.target is not None and self.arrived >= self.target.seq:
+            self._events.append(TargetReached(self.target.seq))
+            self.target = None
+        if self.target is None and self._targets:
+            self.target = self._targets.popleft()
 
     # -- messages ------------------------------------------------------------------------
     def _receive(self, sender, message, detected, out) -> None:
@@ -295,10 +321,13 @@ class RoleSwitchingRobot(Controller):
             if message.leader is not None and (
                     self.leader is None or message.leader.stamp > self.leader.stamp):
                 self.leader = message.leader
-            if message.target is not None and (
+            if message.target is not None and self.role is not Role.BASE_STATION and (
                     self.target is None or message.target.seq > self.target.seq):
-                self.target = message.target
+                self.target = message.target  # the base station's come from the experimenter
             self.arrived = max(self.arrived, message.arrived)
+        elif isinstance(message, Target):
+            if self.role is Role.BASE_STATION:
+                self._targets.append(message)
         elif isinstance(message, Lead):
             self.role, self._collect_armed = Role.LOCAL_LEADER, False
             self.parent = message.parent if message.parent is not None else self.parent
