@@ -2,7 +2,9 @@
 reaches the world's ground truth. Every Observation handed out and every Message
 delivered in a short run of each experiment is walked (attributes and containers, to a
 bounded depth) and must not reference a World, a Simulation, a beacon store (a dict of
-beacons), the Radio, MuJoCo's model or data, or a robot's controller."""
+beacons), the Radio, MuJoCo's model or data, or a robot's controller. And the other way
+round: an experiment's loop functions reach a controller only through the Controller
+protocol (a :class:`Sealed` controller fails on anything else)."""
 
 from __future__ import annotations
 
@@ -181,6 +183,64 @@ def test_patrol_hands_out_nothing_forbidden(watched):
     from mjswarm.experiments.patrol import run_trial
 
     run_trial(6, 0, "point", steps=60)
+    _clean(watched, 100)
+
+
+class Sealed(Controller):
+    """A controller nobody may look into: only the Controller protocol (reset, perceive,
+    step, telemetry) reaches the robot inside; reading or writing anything else fails."""
+
+    PROTOCOL = frozenset({"reset", "perceive", "step", "telemetry"})
+
+    def __init__(self, inner: Controller) -> None:
+        object.__setattr__(self, "_inner", inner)
+
+    def __getattribute__(self, name):
+        if name in Sealed.PROTOCOL or (name.startswith("__") and name.endswith("__")):
+            return object.__getattribute__(self, name)
+        raise AssertionError(f"something read the controller's {name!r}")
+
+    def __setattr__(self, name, value):
+        raise AssertionError(f"something wrote the controller's {name!r}")
+
+    def _inside(self) -> Controller:
+        return object.__getattribute__(self, "_inner")
+
+    def reset(self):
+        Sealed._inside(self).reset()
+
+    def perceive(self, observation):
+        Sealed._inside(self).perceive(observation)
+
+    def step(self, observation):
+        return Sealed._inside(self).step(observation)
+
+    def telemetry(self):
+        return Sealed._inside(self).telemetry()
+
+
+def test_a_sealed_controller_refuses_its_attributes():
+    from algorithms.maintenance.roles import Role, RoleParams, RoleSwitchingRobot
+
+    robot = Sealed(RoleSwitchingRobot(1, Role.EXPLORER, RoleParams()))
+    assert robot.telemetry()["role"] == list(Role).index(Role.EXPLORER)
+    with pytest.raises(AssertionError, match="read the controller's 'role'"):
+        robot.role
+    with pytest.raises(AssertionError, match="wrote the controller's 'target'"):
+        robot.target = None
+
+
+def test_the_patrol_experimenter_talks_to_robots_only_through_the_protocol(watched,
+                                                                           monkeypatch):
+    """Targets go to the base station as messages, roles and connections come back as
+    signals and events (issue 28, items 3 and 4): the mission runs on sealed robots."""
+    from algorithms.maintenance.roles import RoleSwitchingRobot
+    from mjswarm.experiments import patrol
+
+    monkeypatch.setattr(patrol, "RoleSwitchingRobot",
+                        lambda *a, **k: Sealed(RoleSwitchingRobot(*a, **k)))
+    result = patrol.run_trial(10, 0, "point", steps=600)
+    assert result.targets_reached >= 1 and result.aat_robots["tests_per_robot_step"] > 0
     _clean(watched, 100)
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import networkx as nx
 import numpy as np
@@ -10,6 +11,7 @@ import pytest
 
 from algorithms.maintenance.roles import (
     ChildAt,
+    Connections,
     Detected,
     Lead,
     LeaderInfo,
@@ -18,7 +20,10 @@ from algorithms.maintenance.roles import (
     RoleParams,
     RoleSwitchingRobot,
     State,
+    Target,
+    TargetReached,
 )
+from algorithms.robot import Detection, Message, Observation
 from mjswarm.cli import main
 from mjswarm.experiments.patrol import run_trial
 
@@ -30,8 +35,7 @@ def _state(role, x, degree):
 
 
 def _leader(parent_role=Role.REPEATER, parent_at=(0.0, 0.0)):
-    ll = RoleSwitchingRobot(1, Role.LOCAL_LEADER, P, parent=0)
-    ll.connections = {0}
+    ll = RoleSwitchingRobot(1, Role.LOCAL_LEADER, P, parent=0, connections={0})
     return ll, {0: Detected(np.array(parent_at), parent_role)}
 
 
@@ -97,6 +101,27 @@ def test_repeater_answers_where_its_child_is():
                 8: Detected(np.array([4.0, 2.0]), Role.LOCAL_LEADER)}
     _, out = rp.tick(3, np.array([2.0, 1.0]), detected, [(5, Query())])
     assert (5, ChildAt((4.0, 2.0))) in out
+
+
+def test_the_base_station_takes_the_next_target_the_tick_after_it_hears_the_arrival():
+    """Targets come as messages, one ahead; the arrival goes out as an event (Sect. IV-B)."""
+    first, second = Target(0, (4.0, 4.0)), Target(1, (1.0, 5.0))
+    base = RoleSwitchingRobot(0, Role.BASE_STATION, P, child=1, connections={1}, target=first)
+    leader = {1: Detection(math.sqrt(2.0), math.pi / 4, Role.LOCAL_LEADER)}
+
+    def step(tick, *inbox):
+        command = base.step(Observation(0, tick * base.step_s, pose=(0.0, 0.0, 0.0),
+                                        detections=leader, inbox=inbox))
+        return [m.payload.target for m in command.messages], command.events
+
+    assert step(0, Message(second, 0, "control")) == ([first], (Connections(frozenset({1})),))
+    arrived = Message(State(Role.LOCAL_LEADER, (4.0, 4.0), (0.0, 0.0), 1, None, None, first, 0),
+                      0, 1)
+    assert step(1, arrived) == ([first], (TargetReached(0),))
+    assert step(2, arrived) == ([second], ())  # reported once, switched the tick after
+    done = arrived._replace(payload=arrived.payload._replace(target=second, arrived=1))
+    assert step(3, done) == ([second], (TargetReached(1),))
+    assert step(4) == ([None], ())  # no target sent yet: none
 
 
 @pytest.mark.parametrize("seed", range(4))

@@ -34,6 +34,14 @@ Choices where the paper is silent (all parameters are in :class:`RoleParams`):
 * Positions of other robots come from detection (current), their ``u_j`` and ``|A_j|``
   from their last state (one step old). Detection also tells the role (the paper's
   recovery needs to recognise repeaters and the base station).
+* Targets (Sect. IV-B: "the simulator informs the base station"): the base station
+  starts with its first target and is sent the next ones as :class:`Target` messages by
+  the experimenter; it keeps them in order and, as soon as it hears that the local leader
+  reached its current target, reports :class:`TargetReached` and takes the next (the
+  experimenter keeps one ahead, so the switch does not wait for a message).
+* What the experimenter learns of a robot comes from its events (``Command.events``:
+  :class:`TargetReached`, :class:`Connections` whenever ``A_i`` changes), the role it shows
+  (``Command.signal``) and :meth:`RoleSwitchingRobot.telemetry`, never its attributes.
 * Role requests (:class:`Lead`) and (dis)connection requests are messages to one robot.
   A local leader that must become a repeater but has no explorer within reach to hand
   over to keeps its role and stops (``u_i = 0``) until one joins. Line 5 is armed only
@@ -53,7 +61,8 @@ from __future__ import annotations
 import enum
 import math
 import time
-from collections.abc import Hashable, Mapping
+from collections import deque
+from collections.abc import Hashable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -138,6 +147,20 @@ class State(NamedTuple):
     arrived: int
 
 
+class TargetReached(NamedTuple):
+    """Event of the base station (``Command.events``): it heard that the local leader
+    reached target ``seq`` (Sect. IV-B's cue for the next target)."""
+
+    seq: int
+
+
+class Connections(NamedTuple):
+    """Event of any robot (``Command.events``): its connections ``A_i`` now, reported in
+    the tick they change (and in its first tick); the experimenter's network metric."""
+
+    robots: frozenset
+
+
 class Lead(NamedTuple):
     """Algorithm 1's request "become the local leader" (``parent=None``: keep yours)."""
 
@@ -186,25 +209,32 @@ class RoleSwitchingRobot(Controller):
         role: its initial role.
         params: :class:`RoleParams`.
         parent, child: initial parent / child ids (repeaters, local leader, base station).
+        connections: its initial connections ``A_i`` (the deployment's base station -
+            local leader link).
+        target: the base station's first :class:`Target` (the next ones come as messages).
         every_step_aat: run the Acute Angle Test on every candidate every step (the
             baseline) instead of Algorithm 2.
         step_s: the duration of one timestep (s), the control period.
 
     Counters ``angle_tests``, ``circle_tests`` and ``aat_seconds`` (wall time, s)
-    accumulate the cost of the AAT.
+    accumulate the cost of the AAT; :meth:`telemetry` reports them.
     """
 
     def __init__(self, ident: Hashable, role: Role, params: RoleParams, *,
                  parent: Hashable | None = None, child: Hashable | None = None,
+                 connections: Iterable[Hashable] = (), target: Target | None = None,
                  every_step_aat: bool = False, step_s: float = 0.15) -> None:
         self.id, self.role, self.params = ident, role, params
         self.step_s = step_s
         self.parent, self.child = parent, child
         self.every_step_aat = every_step_aat
-        self.connections: set = set()
+        self.connections: set = set(connections)
         self.leader: LeaderInfo | None = None
-        self.target: Target | None = None
+        self.target = target
         self.arrived = -1
+        self._targets: deque[Target] = deque()  # the base station's next targets
+        self._events: list = []  # this tick's events
+        self._reported: frozenset | None = None  # A_i as last reported
         self.u = np.zeros(2)
         self.angle_tests = 0
         self.circle_tests = 0
@@ -234,18 +264,22 @@ class RoleSwitchingRobot(Controller):
                            [(m.sender, m.payload) for m in observation.inbox])
         return Command(velocity_m_s=tuple((u / self.step_s).tolist()),
                        messages=tuple(Message(payload, to) for to, payload in out),
-                       signal=self.role)
+                       signal=self.role, events=tuple(self._events))
 
     def telemetry(self) -> dict[str, float]:
-        """Its role (0 base station, 1 repeater, 2 local leader, 3 explorer) and the
-        number of robots it is connected to (|A_i|)."""
-        return {"role": list(Role).index(self.role), "connections": len(self.connections)}
+        """Its role (0 base station, 1 repeater, 2 local leader, 3 explorer, the order of
+        :class:`Role`), the number of robots it is connected to (|A_i|) and the AAT's
+        cost so far: angle and circle tests, and the wall time they took (s)."""
+        return {"role": list(Role).index(self.role), "connections": len(self.connections),
+                "angle_tests": self.angle_tests, "circle_tests": self.circle_tests,
+                "aat_s": self.aat_seconds}
 
     def tick(self, now: int, x: np.ndarray, detected: Mapping[Hashable, Detected],
              inbox: list[tuple[Hashable, object]]) -> tuple[np.ndarray, list[tuple]]:
         """One timestep: returns ``(u_i, [(recipient, message), ...])``; ``u_i`` in m/step."""
         x = np.asarray(x, float)
         out: list[tuple] = []
+        self._events = []
         for sender, message in inbox:
             self._receive(sender, message, detected, out)
         self._link_layer(x, detected)
@@ -263,7 +297,22 @@ class RoleSwitchingRobot(Controller):
                       self.leader, self.target, self.arrived)
         out.extend((j, state) for j in sorted(self.connections))
         self._previous_role = self.role
+        if self.role is Role.BASE_STATION:
+            self._next_target()
+        if self.connections != self._reported:
+            self._reported = frozenset(self.connections)
+            self._events.append(Connections(self._reported))
         return self.u, out
+
+    def _next_target(self) -> None:
+        """The base station, after its state went out: once it has heard that the local
+        leader reached its target (Sect. IV-B), report it and take the next target it
+        was sent (none until one comes)."""
+        if self.target is not None and self.arrived >= self.target.seq:
+            self._events.append(TargetReached(self.target.seq))
+            self.target = None
+        if self.target is None and self._targets:
+            self.target = self._targets.popleft()
 
     # -- messages ------------------------------------------------------------------------
     def _receive(self, sender, message, detected, out) -> None:
@@ -272,10 +321,13 @@ class RoleSwitchingRobot(Controller):
             if message.leader is not None and (
                     self.leader is None or message.leader.stamp > self.leader.stamp):
                 self.leader = message.leader
-            if message.target is not None and (
+            if message.target is not None and self.role is not Role.BASE_STATION and (
                     self.target is None or message.target.seq > self.target.seq):
-                self.target = message.target
+                self.target = message.target  # the base station's come from the experimenter
             self.arrived = max(self.arrived, message.arrived)
+        elif isinstance(message, Target):
+            if self.role is Role.BASE_STATION:
+                self._targets.append(message)
         elif isinstance(message, Lead):
             self.role, self._collect_armed = Role.LOCAL_LEADER, False
             self.parent = message.parent if message.parent is not None else self.parent

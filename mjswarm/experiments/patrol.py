@@ -6,7 +6,9 @@ apart and 0.2 m from the base station; the one closest to the base station is th
 leader, the rest explorers; the draw is repeated until the network (base station - local
 leader link plus the Gabriel graph of the others within d_c) is connected. The base
 station is given a target drawn in ``[0, 1.8 sqrt(N)]^2`` m and a new one as soon as it
-hears the local leader's arrival; the mission lasts ``steps`` timesteps of
+hears the local leader's arrival (the experimenter sends targets as messages and learns
+of arrivals from the base station's events: :mod:`.patrol_mission`, whose loop functions
+also take the measurements below); the mission lasts ``steps`` timesteps of
 ``STEP_S`` = 0.15 s (1 paper unit = 1 m, so the paper's 0.03 unit/step cap is the Spark
 V's 0.2 m/s).
 
@@ -24,8 +26,8 @@ the robots):
 * messages: copies received (radio counter) per robot per step;
 * algebraic connectivity (networkx) of the network, sampled every ``sample_every`` steps;
 * the AAT's cost as the robots ran it (``aat_robots``: Algorithm 2, or the baseline
-  with ``every_step_aat``; their own counters and time) and, on the same
-  positions every step, the every-step baseline run in the shadow (not used for
+  with ``every_step_aat``; their own counters and time, from their telemetry) and, on
+  the same positions every step, the every-step baseline run in the shadow (not used for
   control), with the algebraic connectivity of the local-leader-and-explorer graph that
   each gives (Fig. 4, 5).
 """
@@ -40,18 +42,12 @@ from dataclasses import asdict, dataclass, field
 import networkx as nx
 import numpy as np
 
-from algorithms.maintenance.gabriel import gabriel_graph, refresh_connections
-from algorithms.maintenance.roles import (
-    FLOCK,
-    Detected,
-    Role,
-    RoleParams,
-    RoleSwitchingRobot,
-    Target,
-)
+from algorithms.maintenance.gabriel import gabriel_graph
+from algorithms.maintenance.roles import Role, RoleParams, RoleSwitchingRobot, Target
 from algorithms.robot import Command, Controller, Observation
 from mjswarm.errors import MjswarmError
-from mjswarm.worlds.loop import Loop, LoopFunctions, Scene
+from mjswarm.experiments.patrol_mission import PatrolMission, draw_target, runs
+from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.openfloor import EmbodiedFloor, MotionWorld, PointWorld
 from mjswarm.core.radio import Radio
 
@@ -133,144 +129,51 @@ def make_world(kind: str, positions: np.ndarray, seed: int, d_s: float) -> Motio
 
 class Timed(Controller):
     """A controller measured: wall time of its steps (s), in total and by the role the
-    robot had when the step began (the paper's processing time, Fig. 8-9)."""
+    robot showed when the step began (the paper's processing time, Fig. 8-9); ``role``
+    is the one it starts with."""
 
-    def __init__(self, inner: RoleSwitchingRobot) -> None:
-        self.inner = inner
+    def __init__(self, inner: Controller, role: Role) -> None:
+        self.inner, self.role = inner, role
         self.seconds = 0.0
         self.by_role: dict[str, list[float]] = {}
 
+    def reset(self) -> None:
+        self.inner.reset()
+
     def step(self, observation: Observation) -> Command:
-        role = self.inner.role.value
         t0 = time.perf_counter()
         command = self.inner.step(observation)
         elapsed = time.perf_counter() - t0
         self.seconds += elapsed
-        spent = self.by_role.setdefault(role, [0.0, 0])
+        spent = self.by_role.setdefault(self.role.value, [0.0, 0])
         spent[0] += elapsed
         spent[1] += 1
+        if command.signal is not None:
+            self.role = command.signal
         return command
 
     def telemetry(self):
         return self.inner.telemetry()
 
 
-def network_graph(minds: list[RoleSwitchingRobot], xy: np.ndarray, d_c: float) -> nx.Graph:
-    """Mutual connections no longer than ``d_c`` (ground-truth positions ``xy``, m)."""
-    g = nx.Graph()
-    g.add_nodes_from(range(len(minds)))
-    for i, m in enumerate(minds):
-        for j in m.connections:
-            if j > i and i in minds[j].connections and np.linalg.norm(xy[i] - xy[j]) <= d_c:
-                g.add_edge(i, j)
-    return g
-
-
-def _runs(flags: list[bool]) -> list[int]:
-    """Lengths of the maximal runs of True in ``flags``."""
-    runs, length = [], 0
-    for f in flags:
-        if f:
-            length += 1
-        elif length:
-            runs.append(length)
-            length = 0
-    return runs + ([length] if length else [])
-
-
-class PatrolMission(LoopFunctions):
-    """The mission's loop functions: targets for the base station, and the measurements
-    of the module docstring (ground truth, never seen by the robots)."""
-
-    def __init__(self, robots: int, rng: np.random.Generator, params: RoleParams,
-                 minds: list[RoleSwitchingRobot], sample_every: int, keep_history: bool,
-                 progress: Callable[[int], None] | None) -> None:
-        self.robots, self.rng, self.params, self.minds = robots, rng, params, minds
-        self.sample_every, self.keep_history, self.progress = sample_every, keep_history, progress
-        self.side = 1.8 * math.sqrt(robots)
-        self.targets = 0
-        self.shadow = {"angle_tests": 0, "seconds": 0.0}
-        self.cut: list[bool] = []
-        self.leader_cut: list[bool] = []
-        self.lam: list[float] = []
-        self.lam_alg2: list[float] = []
-        self.lam_base: list[float] = []
-        self.history: dict[str, list] = {"positions": [], "roles": [], "edges": []}
-        self._flock_base = nx.Graph()
-        self._acted_from = np.zeros((robots, 2))  # true positions at the tick's start
-        self._roles = [m.role for m in minds]
-
-    def scene(self, loop: Loop) -> Scene:
-        """Pictures show the base station's target, the network's links (mutual
-        connections no longer than d_c) and each robot's role."""
-        xy = loop.world.true_positions()
-        graph = network_graph(self.minds, xy, self.params.d_c)
-        return Scene([self.minds[0].target.x], "target (of the leader)",
-                     [(xy[a], xy[b]) for a, b in graph.edges],
-                     [m.role.value for m in self.minds])
-
-    def new_target(self, seq: int) -> Target:
-        """A target drawn in the target square (the simulator informs the base station)."""
-        return Target(seq, tuple(self.rng.uniform(0.0, self.side, 2)))
-
-    def initialize(self, loop: Loop) -> None:
-        for i, mind in enumerate(self.minds):
-            loop.world.show(i, mind.role)  # the experimenter assigns the initial roles
-
-    def before_step(self, loop: Loop) -> None:
-        """The every-step AAT baseline, run in the shadow on the robots each robot
-        detects (within d_s, showing a flock role)."""
-        t, truth = loop.ticks, loop.world.true_positions().copy()
-        self._acted_from = truth
-        self._flock_base = nx.Graph()
-        roles = loop.world.signals
-        for i in range(self.robots):
-            if roles[i] not in FLOCK:
-                continue
-            seen = np.flatnonzero(np.linalg.norm(truth - truth[i], axis=1) <= self.params.d_s)
-            candidates = {int(k): truth[k] for k in seen if k != i and roles[k] in FLOCK}
-            t0 = time.perf_counter()
-            base = refresh_connections(truth[i], (), candidates, range_m=self.params.d_c,
-                                       eta_c=self.params.eta_c, force_full=True)
-            self.shadow["seconds"] += time.perf_counter() - t0
-            self.shadow["angle_tests"] += base.angle_tests
-            if t % self.sample_every == 0:
-                self._flock_base.add_node(i)
-                self._flock_base.add_edges_from((i, k) for k in base.connections)
-
-    def after_step(self, loop: Loop) -> None:
-        """Network metrics on the positions the robots acted from, then the next target."""
-        t = loop.ticks - 1
-        truth = self._acted_from
-        minds = self.minds
-        g = network_graph(minds, truth, self.params.d_c)
-        reach = nx.node_connected_component(g, 0)
-        self.cut.append(len(reach) < self.robots)
-        leaders = [i for i, m in enumerate(minds) if m.role is Role.LOCAL_LEADER]
-        self.leader_cut.append(not leaders or leaders[0] not in reach)
-        if t % self.sample_every == 0:
-            self.lam.append(nx.algebraic_connectivity(g, method="tracemin_lu"))
-            flock = [i for i, m in enumerate(minds) if m.role in FLOCK]
-            for h, out_list in ((g.subgraph(flock), self.lam_alg2),
-                                (self._flock_base, self.lam_base)):
-                out_list.append(nx.algebraic_connectivity(h, method="tracemin_lu")
-                                if h.number_of_nodes() > 1 else 0.0)
-            if self.keep_history:
-                self.history["positions"].append(truth.tolist())
-                self.history["roles"].append([m.role.value for m in minds])
-                self.history["edges"].append(sorted(g.edges()))
-        base_station = minds[0]
-        if base_station.target is not None and base_station.arrived >= base_station.target.seq:
-            self.targets += 1
-            base_station.target = self.new_target(base_station.target.seq + 1)
-            loop.event(f"target {self.targets} reached; next at "
-                              f"({base_station.target.x[0]:.2f}, {base_station.target.x[1]:.2f}) m")
-        for i, m in enumerate(minds):
-            if m.role is not self._roles[i]:
-                loop.event(f"R{i + 1}: {self._roles[i].value} -> {m.role.value}", i)
-                self._roles[i] = m.role
-        if self.progress is not None:
-            self.progress(1)
+def deploy(xy: np.ndarray, params: RoleParams, first: Target,
+           every_step_aat: bool) -> tuple[list[Role], dict[int, frozenset], list[Controller]]:
+    """The experimenter builds the team on positions ``xy`` (m): robot 0 the base
+    station with target ``first``, the robot nearest to it the local leader, linked to
+    it, the rest explorers. Returns the roles, the initial connections and the robots."""
+    n = len(xy)
+    leader = 1 + int(np.argmin(np.linalg.norm(xy[1:], axis=1)))
+    roles = [Role.BASE_STATION] + [Role.EXPLORER] * (n - 1)
+    roles[leader] = Role.LOCAL_LEADER
+    links = {0: frozenset({leader}), leader: frozenset({0})}
+    minds: list[Controller] = [
+        RoleSwitchingRobot(0, Role.BASE_STATION, params, child=leader, connections=links[0],
+                           target=first, step_s=STEP_S)]
+    for i in range(1, n):
+        minds.append(RoleSwitchingRobot(i, roles[i], params, parent=0 if i == leader else None,
+                                        connections=links.get(i, ()),
+                                        every_step_aat=every_step_aat, step_s=STEP_S))
+    return roles, links, minds
 
 
 def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
@@ -288,18 +191,13 @@ def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
     started = time.perf_counter()
     rng = np.random.default_rng(seed)
     xy0 = initial_positions(robots, rng, params)
-    leader = 1 + int(np.argmin(np.linalg.norm(xy0[1:], axis=1)))
-    minds = [RoleSwitchingRobot(i, Role.EXPLORER, params, every_step_aat=every_step_aat,
-                                step_s=STEP_S) for i in range(robots)]
-    minds[0] = RoleSwitchingRobot(0, Role.BASE_STATION, params, child=leader, step_s=STEP_S)
-    minds[leader] = RoleSwitchingRobot(leader, Role.LOCAL_LEADER, params, parent=0,
-                                       every_step_aat=every_step_aat, step_s=STEP_S)
-    minds[0].connections, minds[leader].connections = {leader}, {0}
-    mission = PatrolMission(robots, rng, params, minds, sample_every, keep_history, progress)
-    minds[0].target = mission.new_target(0)
+    first = draw_target(rng, robots, 0)
+    roles, links, minds = deploy(xy0, params, first, every_step_aat)
+    mission = PatrolMission(rng, params, roles, links, first, sample_every, keep_history,
+                            progress)
     floor = make_world(world, xy0, seed, params.d_s)
     floor.attach_radio(Radio(range(robots), range_m=params.d_c, rng=seed))
-    timed = [Timed(m) for m in minds]
+    timed = [Timed(m, r) for m, r in zip(minds, roles)]
     loop = Loop(floor, dict(enumerate(timed)), [mission, *functions])
     loop.run(max_ticks=steps)
     robot_steps = robots * steps
@@ -308,14 +206,14 @@ def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
         for role, (seconds, calls) in t.by_role.items():
             cpu_by_role[role][0] += seconds
             cpu_by_role[role][1] += calls
-    angle_alg2 = sum(m.angle_tests for m in minds)
-    circle_alg2 = sum(m.circle_tests for m in minds)
-    shadow, runs = mission.shadow, _runs
+    final = [t.telemetry() for t in timed]  # the robots' AAT counters
+    angle_alg2, circle_alg2 = (sum(f[k] for f in final) for k in ("angle_tests", "circle_tests"))
+    shadow = mission.shadow
     return TrialResult(
         robots=robots, steps=steps, seed=seed, world=world,
         disconnections=len(runs(mission.cut)), recovery_steps=runs(mission.cut),
         leader_gaps=runs(mission.leader_cut), targets_reached=mission.targets,
-        repeaters_final=sum(m.role is Role.REPEATER for m in minds),
+        repeaters_final=sum(r is Role.REPEATER for r in floor.signals),
         processing_s_per_robot_step=float(sum(t.seconds for t in timed) / robot_steps),
         processing_s_per_robot_step_by_role={
             r: (s / k if k else None) for r, (s, k) in cpu_by_role.items()},
@@ -324,7 +222,7 @@ def run_trial(robots: int, seed: int, world: str = "point", steps: int = 2000,
         aat_robots={"angle_tests_per_robot_step": angle_alg2 / robot_steps,
                     "circle_tests_per_robot_step": circle_alg2 / robot_steps,
                     "tests_per_robot_step": (angle_alg2 + circle_alg2) / robot_steps,
-                    "seconds_per_robot_step": sum(m.aat_seconds for m in minds) / robot_steps,
+                    "seconds_per_robot_step": sum(f["aat_s"] for f in final) / robot_steps,
                     "algebraic_connectivity": float(np.mean(mission.lam_alg2))},
         aat_every_step={"angle_tests_per_robot_step": shadow["angle_tests"] / robot_steps,
                         "seconds_per_robot_step": shadow["seconds"] / robot_steps,
