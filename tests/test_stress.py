@@ -14,7 +14,9 @@ from mjswarm.experiments.stress import (
     SAMPLE_TEAMS,
     Noise,
     StressRun,
+    dense_grid,
     grid,
+    main,
     noise_grid,
     noise_table,
     passed,
@@ -64,6 +66,30 @@ DENSE = [StressRun("lattice:6x6", 12, 0.2, 1), StressRun("lattice:8x8", 16, 0.2,
 def test_dense_teams_at_top_speed_complete(run):
     result = run.run(max_sim_time_s=2400.0)
     assert passed(result), (result.ended_because, result.collisions, result.stopped_robots)
+
+
+def test_the_dense_grid_gives_one_robot_for_every_7_5_and_4_edges():
+    runs = dense_grid(arenas=("lattice:6x6",), speeds=(0.2,), seeds=(0,))
+    assert [r.robots for r in runs] == [60 // 7, 60 // 5, 60 // 4]
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--sample"], "--sample needs --noise or --dense"),
+    (["--dense", "--noise"], "choose one of --noise and --dense"),
+    (["--dense", "--only-slip"], "--slip and --only-slip need --noise"),
+])
+def test_stress_flags_that_do_not_go_together_are_refused(capsys, argv, message):
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2 and message in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_the_whole_dense_grid_passes():
+    rows = run_grid(dense_grid(), workers=2)
+    failures = [(r, res.ended_because, res.collisions, res.stopped_robots)
+                for r, res, _ in rows if not passed(res)]
+    assert failures == []
 
 
 @pytest.mark.slow

@@ -12,6 +12,10 @@ The noise grid (issue 27, ``--noise``): one arena of each class at every speed, 
 line noise 0.5 mm, IR noise 2 mm, bearing noise 2 degrees and wheel slip 0.05, each alone
 and all together, in both physics tiers, two seeds; it adds the criterion that the
 robots' odometry heading stays within ``MAX_HEADING_ERROR_DEG`` of the truth.
+
+The dense-team grid (issue 30, ``--dense``): lattices, a hexagonal lattice and a random
+planar graph with one robot for every 7, 5 and 4 edges, at 0.15 and 0.2 m/s, three seeds;
+every run must pass as the stress grid's do.
 """
 
 from __future__ import annotations
@@ -92,6 +96,14 @@ SAMPLE_TEAMS = (4,)
 MAX_HEADING_ERROR_DEG = 5.0
 
 
+#: Issue 30's dense teams: arenas, team sizes as edges per robot, speeds (m/s).
+DENSE_ARENAS = ("lattice:5x5", "lattice:6x6", "lattice:8x8", "hex:3x3", "random-planar:24:3")
+DENSE_EDGES_PER_ROBOT = (7, 5, 4)
+DENSE_SPEEDS_M_S = (0.15, 0.2)
+#: ``--dense --sample``: the densest two teams at the top speed, one seed.
+DENSE_SAMPLE = {"edges_per_robot": (5, 4), "speeds": (0.2,), "seeds": (0,)}
+
+
 @dataclass(frozen=True)
 class StressRun:
     """One cell of the grid."""
@@ -132,6 +144,18 @@ def noise_grid(arenas=NOISE_ARENAS, speeds=SPEEDS_M_S, teams=NOISE_TEAMS, noises
     """Issue 27's grid: every arena class at every speed under every noise, both tiers."""
     return [StressRun(arena, k, v, s, noise, tier) for arena in arenas for k in teams
             for v in speeds for noise in noises for tier in physics for s in seeds]
+
+
+def dense_grid(arenas=DENSE_ARENAS, edges_per_robot=DENSE_EDGES_PER_ROBOT,
+               speeds=DENSE_SPEEDS_M_S, seeds=(0, 1, 2)) -> list[StressRun]:
+    """Issue 30's dense-team grid: ``E // n`` robots for each ``n`` of ``edges_per_robot``
+    (E: the arena's edges), at every speed and seed."""
+    runs = []
+    for arena in arenas:
+        edges = len(StressRun(arena, 1, 0.05, 0).spec().edges)
+        runs += [StressRun(arena, edges // n, v, s) for n in edges_per_robot
+                 for v in speeds for s in seeds]
+    return runs
 
 
 def passed(result: EmbodiedResult, max_heading_error_deg: float = math.inf) -> bool:
@@ -221,9 +245,13 @@ def main(argv: list[str] | None = None) -> int:
                              "classes; every speed, noise level and physics tier)")
     parser.add_argument("--log", type=argparse.FileType("a"), default=None, metavar="FILE",
                         help="append one line per run to FILE as it is done")
+    parser.add_argument("--dense", action="store_true",
+                        help="run issue 30's dense-team grid instead (one robot for every "
+                             "7, 5 and 4 edges, 0.15 and 0.2 m/s, three seeds: 90 runs)")
     parser.add_argument("--sample", action="store_true",
                         help="with --noise: only 0.05 and 0.2 m/s, teams of 4 and one seed "
-                             "(140 runs)")
+                             "(140 runs); with --dense: one robot for every 5 and 4 edges "
+                             "at 0.2 m/s, one seed (10 runs)")
     parser.add_argument("--slip", type=float, default=GRID_SLIP, metavar="S",
                         help=f"with --noise: the wheel slip of its slip levels (default "
                              f"{GRID_SLIP:g})")
@@ -231,8 +259,12 @@ def main(argv: list[str] | None = None) -> int:
                         help="with --noise: only the levels with wheel slip (alone, and "
                              "with every noise together)")
     args = parser.parse_args(argv)
-    if (args.sample or args.only_slip or args.slip != GRID_SLIP) and not args.noise:
-        parser.error("--sample, --slip and --only-slip need --noise")
+    if args.noise and args.dense:
+        parser.error("choose one of --noise and --dense")
+    if (args.only_slip or args.slip != GRID_SLIP) and not args.noise:
+        parser.error("--slip and --only-slip need --noise")
+    if args.sample and not (args.noise or args.dense):
+        parser.error("--sample needs --noise or --dense")
     if not 0.0 <= args.slip < 1.0:
         parser.error(f"--slip must be in [0, 1), got {args.slip:g}")
     if args.noise:
@@ -244,6 +276,12 @@ def main(argv: list[str] | None = None) -> int:
         else:
             runs = noise_grid(arenas=arenas, noises=levels, seeds=range(args.seeds or 2))
         heading = MAX_HEADING_ERROR_DEG
+    elif args.dense:
+        arenas = DENSE_ARENAS if args.arenas is None else args.arenas.split(",")
+        options = dict(DENSE_SAMPLE) if args.sample else {}
+        if args.seeds is not None:
+            options["seeds"] = range(args.seeds)
+        runs, heading = dense_grid(arenas=arenas, **options), math.inf
     else:
         arenas = ARENAS if args.arenas is None else args.arenas.split(",")
         runs, heading = grid(arenas=arenas, seeds=range(args.seeds or 1)), math.inf
