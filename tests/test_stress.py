@@ -85,16 +85,9 @@ def test_stress_flags_that_do_not_go_together_are_refused(capsys, argv, message)
 
 
 @pytest.mark.slow
-def test_the_whole_dense_grid_passes():
-    rows = run_grid(dense_grid(), workers=2)
-    failures = [(r, res.ended_because, res.collisions, res.stopped_robots)
-                for r, res, _ in rows if not passed(res)]
-    assert failures == []
-
-
-@pytest.mark.slow
-def test_the_whole_grid_passes():
-    rows = run_grid(grid(), workers=2)
+@pytest.mark.parametrize("make", [grid, dense_grid], ids=["stress", "dense"])
+def test_the_whole_grid_passes(make):
+    rows = run_grid(make(), workers=2)
     failures = [(r, res.ended_because, res.collisions, res.stopped_robots)
                 for r, res, _ in rows if not passed(res)]
     assert failures == []
