@@ -310,6 +310,37 @@ class Radio:
             addressee = self._index[to] if to in self._neighbors[sender] else -2
         self._outbox.append((Message(payload, to, sender), self._table, self._index[sender], addressee))
 
+    def send_all(self, senders: Sequence[Hashable], payload: Any) -> None:
+        """Every robot of ``senders`` broadcasts ``payload``: as :meth:`send` once per
+        sender, in this order (a team's heartbeat), with one immutability check."""
+        check_immutable(payload)
+        present, sent, index, table = self._present, self.sent, self._index, self._table
+        for sender in senders:
+            if sender not in present:
+                raise MjswarmError(f"radio: robot {sender!r} is not in the team")
+            sent[sender] += 1
+        self._outbox += [(Message(payload, None, r), table, index[r], -1) for r in senders]
+
+    def receive_all(self, robots: Sequence[Hashable]) -> tuple[list[Message], np.ndarray, np.ndarray]:
+        """Drain the inboxes of ``robots`` at once, as :meth:`receive` for each in turn:
+        the messages (each once), the index of each copy into them, robot by robot in
+        delivery order, and each robot's bounds in those copies, shape (len(robots) + 1,)
+        (:class:`~algorithms.batch.Readings`' inbox)."""
+        if any(self._inbox[r] for r in robots) or self._batch is None:  # leftovers: robot by robot
+            inboxes = [self.receive(r) for r in robots]
+            messages = [m for inbox in inboxes for m in inbox]
+            return (messages, np.arange(len(messages)),
+                    np.cumsum([0] + [len(inbox) for inbox in inboxes]))
+        k = np.array([self._index[r] for r in robots], np.intp)
+        messages, copies, bounds = self._batch
+        bounds = np.asarray(bounds)
+        start = bounds[k]
+        count = np.where(self._unread[k], bounds[k + 1] - start, 0)
+        self._unread[k] = False
+        first = np.cumsum(count) - count
+        at = np.repeat(start - first, count) + np.arange(int(count.sum()))
+        return messages, copies[at], np.concatenate([[0], np.cumsum(count)])
+
     def receive(self, robot: Hashable) -> list[Message]:
         """Drain and return what ``robot`` has received (in delivery order)."""
         inbox = self._inbox[robot]
