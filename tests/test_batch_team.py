@@ -146,6 +146,8 @@ def drive_radio(radio, seed: int, ticks: int, names: list, batched: bool) -> lis
         else:
             for r in senders:
                 radio.send(r, ("beat", tick))
+        if rng.random() < 0.2 and len(radio.present) > 2:  # a sender leaves before delivery
+            radio.remove(names[rng.integers(len(names))])
         log.append((tick, radio.last_batch, radio.dropped, radio.pending, dict(radio.sent)))
     return log
 
