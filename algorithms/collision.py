@@ -302,6 +302,8 @@ class BatchCollisionRule:
                beta: np.ndarray) -> np.ndarray:
         """Take the bearings ``beta_kp`` (rad) of this tick's pairs ``(k, p)`` (sorted by
         ``k``, then ``p``) for the robots ``robots`` stepped now; return their ``S_k`` (m/s)."""
+        if not len(k) and not len(self.key):  # nobody in view, before or now
+            return self.speed[robots]
         key = k.astype(np.int64) * self.n + p
         at = np.minimum(np.searchsorted(self.key, key), max(len(self.key) - 1, 0))
         found = self.key[at] == key if len(self.key) else np.zeros(len(key), bool)
@@ -387,11 +389,13 @@ class BatchCollisionRule:
         """Apply speed events in each robot's order (by ``order``), the ``r``-th event of
         every robot in round ``r``. ``code``: a reduction for ``R_p`` that no longer
         applies (eq. 33; ``SLOW``, ``STOP``) or a new one (eq. 27; ``-SLOW``, ``-STOP``)."""
+        if not len(robot):
+            return
         sort = np.lexsort((order, robot))
         robot, code = robot[sort], code[sort]
         rank = np.arange(len(robot)) - np.searchsorted(robot, robot)
         S = self.initial_speed
-        for r in range(int(rank.max()) + 1 if len(rank) else 0):
+        for r in range(int(rank.max()) + 1):
             k, c = robot[rank == r], code[rank == r]
             s, e = self.speed[k], self.step[k]
             self.stops[k] += (c == -STOP).astype(np.int64) - (c == STOP)

@@ -54,6 +54,8 @@ class BearingSensor:
         """Every pair ``(k, p)`` with ``k`` seeing ``p`` now, and ``beta_kp`` (rad), as
         three arrays sorted by ``k``, then ``p`` (one noise draw per pair, in that order)."""
         sim = self.sim
+        if sim.n < 2:  # nobody to see
+            return (np.empty(0, np.int64),) * 2 + (np.empty(0),)
         poses = sim.poses()
         pairs = cKDTree(poses[:, :2]).query_pairs(self.range_m, output_type="ndarray")
         k = np.concatenate([pairs[:, 0], pairs[:, 1]])

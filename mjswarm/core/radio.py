@@ -384,7 +384,7 @@ class Radio:
                 messages.append(entry[0])
         self.last_batch = len(messages)
         self._fold_unread()
-        if not outbox:
+        if all(not len(entry[1][0]) for entry in outbox):  # nothing sent, or nobody linked
             return
         message, recipient = self._copies(outbox)
         keep = self._on_air[recipient]
@@ -470,7 +470,7 @@ class Radio:
 
     def _pairs_in_range(self) -> np.ndarray:
         """Linked pairs in range mode, as robot indices ``(k, l)``, k < l, sorted."""
-        if self._xy is None or not self._present:
+        if self._xy is None or len(self._present) < 2:  # nobody to link
             return np.empty((0, 2), dtype=np.intp)
         if len(self._present) == len(self.robots):
             rows = np.arange(len(self.robots))
