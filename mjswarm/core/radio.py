@@ -54,6 +54,7 @@ from __future__ import annotations
 import math
 import dataclasses
 import enum
+from itertools import repeat
 from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -321,7 +322,8 @@ class Radio:
             if sender not in present:
                 raise MjswarmError(f"radio: robot {sender!r} is not in the team")
             sent[sender] += 1
-        self._outbox.append(([Message(payload, None, r) for r in senders], table,
+        messages = list(map(Message._make, zip(repeat(payload), repeat(None), senders)))
+        self._outbox.append((messages, table,
                              np.fromiter(map(index.__getitem__, senders), np.intp, len(senders)), -1))
 
     def receive_all(self, robots: Sequence[Hashable]) -> tuple[list[Message], np.ndarray, np.ndarray]:
