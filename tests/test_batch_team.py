@@ -167,3 +167,34 @@ def test_radio_batched_send_and_receive_equal_the_old_delivery(seed):
     assert log == drive_radio(reference, seed, 60, names, False)
     assert batched.received == reference.ref_received and batched.dropped == reference.dropped
     assert sum(batched.received.values()) > 100
+
+
+def test_bench_team_commands_what_each_bench_robot_would():
+    """On the same random readings (line sensors about the threshold, some NaN; bearing
+    streams; inboxes), BenchTeam's row ``r`` is BenchRobot's command for the observation
+    view of row ``r``, to the bit, and they count the same messages."""
+    from algorithms.batch import Readings
+    from algorithms.bench_robot import BenchRobot, BenchTeam
+    from algorithms.navigation.percept import LINE_THRESHOLD_M
+    from algorithms.robot import Message
+
+    n, height, eps = 30, 0.02, epsilons(30)
+    team = BenchTeam(BatchCollisionRule(S, np.array(eps)), height)
+    robots = [BenchRobot(CollisionRule(S, e), height) for e in eps]
+    rng = np.random.default_rng(7)
+    ids = np.arange(n)
+    for t, tick in enumerate(bearing_streams(3, n, 200)):
+        line = height - LINE_THRESHOLD_M + rng.choice([-1e-3, 1e-3, np.nan], (n, 3))
+        pairs = [(k, p, b) for k, seen in sorted(tick.items()) for p, b in seen.items()]
+        k, p, b = (np.array(x) for x in zip(*pairs)) if pairs else (np.empty(0, int),) * 3
+        counts = rng.integers(0, 3, n)
+        inbox = [Message(("beat", t), None, int(s)) for s in rng.integers(0, n, counts.sum())]
+        readings = Readings(ids, t * 0.02, line, np.full((n, 3), np.nan), np.zeros((n, 2)),
+                            np.zeros((n, 2)), np.full(n, 7.4), k.astype(int), p.astype(int),
+                            b.astype(float), inbox, np.arange(len(inbox)),
+                            np.concatenate([[0], np.cumsum(counts)]))
+        batch = team.step_all(readings)
+        for r, robot in enumerate(robots):
+            c = robot.step(readings.observation(r))
+            assert (c.v_m_s, c.omega_rad_s, c.messages) == batch.command(r)
+    assert team.heard.tolist() == [r.heard for r in robots]
