@@ -4,12 +4,14 @@ For each robot count N the benchmark builds one world (:func:`mjswarm.worlds.ben
 robots in a grid, each on its own floor strip, walls beside every row) and measures, in the same process and run:
 
 * ``realtime_factor``: simulated seconds per wall second of the full control loop
-  (:func:`bench_loop`: one :class:`~algorithms.bench_robot.BenchRobot` controller per robot in a
+  (:func:`bench_loop`: one batched :class:`~algorithms.bench_robot.BenchTeam` for all robots,
+  or one :class:`~algorithms.bench_robot.BenchRobot` controller per robot, the same run, in a
   :class:`~mjswarm.worlds.sparkworld.SparkWorld`, run by the one :class:`~mjswarm.worlds.loop.Loop`): every robot's line, IR, encoder and wheel-speed readings, its
   bearing sensor (+-60 degrees, 1 m, line of sight), a radio (range ``RADIO_RANGE_M``,
   links need line of sight both ways) on which every robot broadcasts a heartbeat every
   tick and reads its inbox, and per robot the seed-003 speed rule
-  (:class:`~algorithms.collision.CollisionRule`, bearing rates) setting the speed of a
+  (:class:`~algorithms.collision.BatchCollisionRule` over pair arrays, or
+  :class:`~algorithms.collision.CollisionRule` per robot; bearing rates) setting the speed of a
   line follower that steers from the robot's own line sensors;
 * ``physics_only_realtime_factor``: the same for bare ``mj_step`` on the same compiled
   model with sensors disabled and constant controls (dynamic physics in both tiers: the
