@@ -1,10 +1,14 @@
 """The benchmark's robot: a line follower with seed 003's speed rule and a radio
 heartbeat, the per-tick work of a team that senses, decides and talks every tick
-(:mod:`mjswarm.experiments.bench`)."""
+(:mod:`mjswarm.experiments.bench`), as one robot (:class:`BenchRobot`) and as a batched
+team (:class:`BenchTeam`) that commands what every one of its robots would."""
 
 from __future__ import annotations
 
-from algorithms.collision import CollisionRule
+import numpy as np
+
+from algorithms.batch import BatchCommand, BatchController, Readings
+from algorithms.collision import BatchCollisionRule, CollisionRule
 from algorithms.navigation.percept import LINE_THRESHOLD_M
 from algorithms.robot import Command, Controller, Message, Observation
 
@@ -30,3 +34,23 @@ class BenchRobot(Controller):
         turn = (TURN_GAIN_RAD_S if self.height_m - line[0] > LINE_THRESHOLD_M else 0.0) - (
             TURN_GAIN_RAD_S if self.height_m - line[2] > LINE_THRESHOLD_M else 0.0)
         return Command(self.rule.update(observation.bearings), turn, None, HEARTBEAT)
+
+
+class BenchTeam(BatchController):
+    """:class:`BenchRobot` for a whole team at once: the same commands, from arrays (the
+    speed rule over pair arrays, :class:`~algorithms.collision.BatchCollisionRule`);
+    ``heard`` counts each robot's messages (by robot id)."""
+
+    def __init__(self, rule: BatchCollisionRule, line_sensor_height_m: float) -> None:
+        self.rule = rule
+        self.height_m = line_sensor_height_m
+        self.heard = np.zeros(rule.n, np.int64)
+
+    def step_all(self, readings: Readings) -> BatchCommand:
+        robots = readings.robots
+        self.heard[robots] += readings.inbox_counts()
+        dark = self.height_m - readings.line_m[:, ::2] > LINE_THRESHOLD_M  # left, right
+        turn = np.where(dark[:, 0], TURN_GAIN_RAD_S, 0.0) - np.where(dark[:, 1], TURN_GAIN_RAD_S, 0.0)
+        speed = self.rule.update(robots, robots[readings.bearing_row], readings.bearing_id,
+                                 readings.bearing_rad)
+        return BatchCommand(speed, turn, np.ones(len(robots), bool), HEARTBEAT[0].payload)

@@ -66,7 +66,7 @@ def bench(physics: str, robots: int, ticks: int) -> None:
     loop.run(max_ticks=ticks)
     wall = time.perf_counter() - start
     radio = loop.world.radio
-    heard = [loop.controllers[i].heard for i in range(robots)]
+    heard = loop.team.heard.tolist()
     digest.update(repr((radio.sent, radio.received, radio.dropped, heard)).encode())
     print(f"bench {physics} {robots} robots, {ticks} ticks: wall={wall:.2f}s "
           f"sent={radio.total_sent} received={sum(radio.received.values())} "

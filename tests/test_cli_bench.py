@@ -38,3 +38,9 @@ def test_bench_bad_input_is_one_line(capsys, argv, message):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
+
+
+def test_bench_measures_the_per_robot_loop_on_request(capsys):
+    assert main(["bench", "--robots", "3", "--seconds", "0.1", "--per-robot", "--json"]) == 0
+    (result,) = json.loads(capsys.readouterr().out)["results"]
+    assert result["robots"] == 3 and result["realtime_factor"] > 0

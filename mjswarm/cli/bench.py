@@ -47,6 +47,9 @@ def register(subparsers) -> None:
                         help="the full loop's physics tier: dynamic (MuJoCo's contact physics; "
                              "default) or kinematic (wheel kinematics, stop at contacts); bare "
                              "mj_step is dynamic in both, so the ratio says what the tier saves")
+    parser.add_argument("--per-robot", action="store_true",
+                        help="step one controller per robot (observations and commands one by "
+                             "one) instead of the batched team (arrays; default): the same run")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
 
@@ -59,7 +62,8 @@ def run(args) -> int:
     model = args.model or str(DEFAULT_ROBOT_XML)
     load_robot_spec(model)  # fail with one line before any progress bar
     results = [
-        as_dict(run_bench(n, args.seconds, model, args.sensing, physics=args.physics))
+        as_dict(run_bench(n, args.seconds, model, args.sensing, physics=args.physics,
+                          batched=not args.per_robot))
         for n in tqdm(counts, desc="bench", unit="world", disable=None, file=sys.stderr)
     ]
     if args.json:

@@ -41,9 +41,22 @@ class BearingSensor:
 
     def read(self) -> list[dict[int, float]]:
         """For every robot ``k``: ``{p: beta_kp}`` (rad) of the robots it sees now."""
+        return self.as_dicts(*self.read_pairs())
+
+    def as_dicts(self, k: np.ndarray, p: np.ndarray, beta: np.ndarray) -> list[dict[int, float]]:
+        """:meth:`read_pairs`' pairs as one ``{p: beta_kp}`` per robot ``k``."""
+        out: list[dict[int, float]] = [{} for _ in range(self.sim.n)]
+        for ki, pi, b in zip(k.tolist(), p.tolist(), beta.tolist()):
+            out[ki][pi] = b
+        return out
+
+    def read_pairs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Every pair ``(k, p)`` with ``k`` seeing ``p`` now, and ``beta_kp`` (rad), as
+        three arrays sorted by ``k``, then ``p`` (one noise draw per pair, in that order)."""
         sim = self.sim
+        if sim.n < 2:  # nobody to see
+            return (np.empty(0, np.int64),) * 2 + (np.empty(0),)
         poses = sim.poses()
-        n = len(poses)
         pairs = cKDTree(poses[:, :2]).query_pairs(self.range_m, output_type="ndarray")
         k = np.concatenate([pairs[:, 0], pairs[:, 1]])
         p = np.concatenate([pairs[:, 1], pairs[:, 0]])
@@ -58,7 +71,4 @@ class BearingSensor:
         k, p, beta = k[order], p[order], beta[order]
         if self.noise_rad:
             beta = beta + self.rng.normal(0.0, self.noise_rad, len(beta))
-        out: list[dict[int, float]] = [{} for _ in range(n)]
-        for ki, pi, b in zip(k.tolist(), p.tolist(), beta.tolist()):
-            out[ki][pi] = b
-        return out
+        return k, p, beta

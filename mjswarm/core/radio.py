@@ -54,6 +54,7 @@ from __future__ import annotations
 import math
 import dataclasses
 import enum
+from itertools import repeat
 from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -192,8 +193,9 @@ class Radio:
         self._edges: frozenset[frozenset] | None = None
         self._xy: np.ndarray | None = None  # positions (metres), one row per robot, in order
         #: this tick's transmissions: (message, link table at sending, sender index,
-        #: addressee index: -1 everybody who hears it, -2 nobody)
-        self._outbox: list[tuple[Message, tuple, int, int]] = []
+        #: addressee index: -1 everybody who hears it, -2 nobody), or a team's broadcast
+        #: (:meth:`send_all`): (its messages as a list, the table, the senders' indices, -1)
+        self._outbox: list[tuple] = []
         self._inbox: dict[Hashable, list[Message]] = {r: [] for r in self.robots}
         #: the last delivery, cut per robot when it asks: messages, message index of each
         #: copy sorted by recipient, each robot's slice of them, who has not asked yet
@@ -231,7 +233,8 @@ class Radio:
         """The robot leaves (crash or recall): no links, nothing more sent to or by it."""
         self._present.pop(robot, None)
         self._on_air[self._index[robot]] = False
-        self._outbox = [m for m in self._outbox if m[0].sender != robot]
+        self._outbox = [self._without(e, robot) if type(e[0]) is list else e
+                        for e in self._outbox if type(e[0]) is list or e[0].sender != robot]
         self._inbox[robot].clear()
         self._unread[self._index[robot]] = False  # what it had not read is lost
         self._relink()
@@ -310,6 +313,39 @@ class Radio:
             addressee = self._index[to] if to in self._neighbors[sender] else -2
         self._outbox.append((Message(payload, to, sender), self._table, self._index[sender], addressee))
 
+    def send_all(self, senders: Sequence[Hashable], payload: Any) -> None:
+        """Every robot of ``senders`` broadcasts ``payload``: as :meth:`send` once per
+        sender, in this order (a team's heartbeat), with one immutability check."""
+        check_immutable(payload)
+        present, sent, index, table = self._present, self.sent, self._index, self._table
+        for sender in senders:
+            if sender not in present:
+                raise MjswarmError(f"radio: robot {sender!r} is not in the team")
+            sent[sender] += 1
+        messages = list(map(Message._make, zip(repeat(payload), repeat(None), senders)))
+        self._outbox.append((messages, table,
+                             np.fromiter(map(index.__getitem__, senders), np.intp, len(senders)), -1))
+
+    def receive_all(self, robots: Sequence[Hashable]) -> tuple[list[Message], np.ndarray, np.ndarray]:
+        """Drain the inboxes of ``robots`` at once, as :meth:`receive` for each in turn:
+        the messages (each once), the index of each copy into them, robot by robot in
+        delivery order, and each robot's bounds in those copies, shape (len(robots) + 1,)
+        (:class:`~algorithms.batch.Readings`' inbox)."""
+        if any(self._inbox[r] for r in robots) or self._batch is None:  # leftovers: robot by robot
+            inboxes = [self.receive(r) for r in robots]
+            messages = [m for inbox in inboxes for m in inbox]
+            return (messages, np.arange(len(messages)),
+                    np.cumsum([0] + [len(inbox) for inbox in inboxes]))
+        k = np.array([self._index[r] for r in robots], np.intp)
+        messages, copies, bounds = self._batch
+        bounds = np.asarray(bounds)
+        start = bounds[k]
+        count = np.where(self._unread[k], bounds[k + 1] - start, 0)
+        self._unread[k] = False
+        first = np.cumsum(count) - count
+        at = np.repeat(start - first, count) + np.arange(int(count.sum()))
+        return messages, copies[at], np.concatenate([[0], np.cumsum(count)])
+
     def receive(self, robot: Hashable) -> list[Message]:
         """Drain and return what ``robot`` has received (in delivery order)."""
         inbox = self._inbox[robot]
@@ -332,7 +368,7 @@ class Radio:
     @property
     def pending(self) -> int:
         """Transmissions sent this tick and not yet delivered."""
-        return len(self._outbox)
+        return sum(len(e[0]) if type(e[0]) is list else 1 for e in self._outbox)
 
     @property
     def total_sent(self) -> int:
@@ -342,9 +378,15 @@ class Radio:
     # -- internals ----------------------------------------------------------------------
     def _deliver(self) -> None:
         outbox, self._outbox = self._outbox, []
-        self.last_batch = len(outbox)
+        messages = []
+        for entry in outbox:  # every transmission's message, in send order
+            if type(entry[0]) is list:
+                messages += entry[0]
+            else:
+                messages.append(entry[0])
+        self.last_batch = len(messages)
         self._fold_unread()
-        if not outbox:
+        if all(not len(entry[1][0]) for entry in outbox):  # nothing sent, or nobody linked
             return
         message, recipient = self._copies(outbox)
         keep = self._on_air[recipient]
@@ -360,24 +402,30 @@ class Radio:
         self._received += counts
         order = np.argsort(recipient, kind="stable")  # per recipient, in send order
         bounds = np.concatenate([[0], np.cumsum(counts)]).tolist()
-        self._batch = ([m[0] for m in outbox], message[order], bounds)
+        self._batch = (messages, message[order], bounds)
         self._unread = counts > 0
 
-    def _copies(self, outbox: list[tuple[Message, tuple, int, int]]) -> tuple[np.ndarray, np.ndarray]:
+    def _copies(self, outbox: list[tuple]) -> tuple[np.ndarray, np.ndarray]:
         """Every copy of the outbox's messages as (message index, recipient index), in send
         order and, within a message, in robot order: the senders' neighbours in the link
-        table of their sending (or the one addressee that hears it)."""
+        table of their sending (or the one addressee that hears it). A team's broadcast
+        counts as its senders' transmissions, one after another."""
         tables: dict[int, int] = {}  # id(table) -> its offset in the joined neighbour lists
         parts: list[np.ndarray] = []
         size = 0
-        start, count = [], []
-        for _, table, sender, addressee in outbox:
+        start, count = [], []  # per transmission, in runs between teams' broadcasts
+        pieces: list = []  # the runs and the teams' (start, count) arrays, in send order
+        for first, table, sender, addressee in outbox:
             offset = tables.get(id(table))
             if offset is None:
                 offset = tables[id(table)] = size
                 parts.append(table[0])
                 size += len(table[0])
-            if addressee == -1:
+            if addressee == -1 and type(first) is list:
+                bounds = table[1]
+                pieces += [(start, count), (offset + bounds[sender], bounds[sender + 1] - bounds[sender])]
+                start, count = [], []
+            elif addressee == -1:
                 bounds = table[1]
                 start.append(offset + bounds[sender])
                 count.append(bounds[sender + 1] - bounds[sender])
@@ -389,13 +437,20 @@ class Radio:
             else:
                 start.append(0)
                 count.append(0)
+        pieces.append((start, count))
         joined = np.concatenate(parts) if len(parts) > 1 else parts[0]
-        count_a = np.array(count, np.intp)
+        start_a = np.concatenate([np.asarray(s, np.intp) for s, _ in pieces])
+        count_a = np.concatenate([np.asarray(c, np.intp) for _, c in pieces])
         total = int(count_a.sum())
-        message = np.repeat(np.arange(len(outbox)), count_a)
-        first = np.cumsum(count_a) - count_a
-        at = np.repeat(np.array(start, np.intp) - first, count_a) + np.arange(total)
+        message = np.repeat(np.arange(len(count_a)), count_a)
+        first_copy = np.cumsum(count_a) - count_a
+        at = np.repeat(start_a - first_copy, count_a) + np.arange(total)
         return message, joined[at]
+
+    def _without(self, entry: tuple, robot: Hashable) -> tuple:
+        """A team's broadcast (an outbox entry of :meth:`send_all`) without ``robot``'s."""
+        keep = entry[2] != self._index[robot]
+        return ([m for m, kept in zip(entry[0], keep.tolist()) if kept], entry[1], entry[2][keep], -1)
 
     def _fold_unread(self) -> None:
         """Copies of the last delivery that nobody asked for yet join their inboxes."""
@@ -417,7 +472,7 @@ class Radio:
 
     def _pairs_in_range(self) -> np.ndarray:
         """Linked pairs in range mode, as robot indices ``(k, l)``, k < l, sorted."""
-        if self._xy is None or not self._present:
+        if self._xy is None or len(self._present) < 2:  # nobody to link
             return np.empty((0, 2), dtype=np.intp)
         if len(self._present) == len(self.robots):
             rows = np.arange(len(self.robots))

@@ -4,12 +4,14 @@ For each robot count N the benchmark builds one world (:func:`mjswarm.worlds.ben
 robots in a grid, each on its own floor strip, walls beside every row) and measures, in the same process and run:
 
 * ``realtime_factor``: simulated seconds per wall second of the full control loop
-  (:func:`bench_loop`: one :class:`~algorithms.bench_robot.BenchRobot` controller per robot in a
+  (:func:`bench_loop`: one batched :class:`~algorithms.bench_robot.BenchTeam` for all robots,
+  or one :class:`~algorithms.bench_robot.BenchRobot` controller per robot, the same run, in a
   :class:`~mjswarm.worlds.sparkworld.SparkWorld`, run by the one :class:`~mjswarm.worlds.loop.Loop`): every robot's line, IR, encoder and wheel-speed readings, its
   bearing sensor (+-60 degrees, 1 m, line of sight), a radio (range ``RADIO_RANGE_M``,
   links need line of sight both ways) on which every robot broadcasts a heartbeat every
   tick and reads its inbox, and per robot the seed-003 speed rule
-  (:class:`~algorithms.collision.CollisionRule`, bearing rates) setting the speed of a
+  (:class:`~algorithms.collision.BatchCollisionRule` over pair arrays, or
+  :class:`~algorithms.collision.CollisionRule` per robot; bearing rates) setting the speed of a
   line follower that steers from the robot's own line sensors;
 * ``physics_only_realtime_factor``: the same for bare ``mj_step`` on the same compiled
   model with sensors disabled and constant controls (dynamic physics in both tiers: the
@@ -29,8 +31,8 @@ from dataclasses import asdict, dataclass
 import mujoco
 import numpy as np
 
-from algorithms.bench_robot import BenchRobot
-from algorithms.collision import CollisionRule, epsilons
+from algorithms.bench_robot import BenchRobot, BenchTeam
+from algorithms.collision import BatchCollisionRule, CollisionRule, epsilons
 from mjswarm.core.bearing import BearingSensor
 from mjswarm.core.radio import Radio, sight_blocker
 from mjswarm.core.robot import DEFAULT_ROBOT_XML
@@ -60,20 +62,27 @@ class BenchResult:
     robot_steps_per_s: float
 
 
-def bench_loop(sim: Simulation) -> Loop:
-    """The full per-tick loop of N robots (module docstring) on ``sim``."""
+def bench_loop(sim: Simulation, batched: bool = True) -> Loop:
+    """The full per-tick loop of N robots (module docstring) on ``sim``: one
+    :class:`~algorithms.bench_robot.BenchTeam` for all (``batched``), else one
+    :class:`~algorithms.bench_robot.BenchRobot` per robot (the reference: the same run)."""
     world = SparkWorld(sim, BearingSensor(sim))
     world.attach_radio(Radio(range(sim.n), range_m=RADIO_RANGE_M, blocked=sight_blocker(sim)))
-    height = sim.geometry.line_sensor_height_m
+    height, eps = sim.geometry.line_sensor_height_m, epsilons(sim.n)
+    if batched:
+        rule = BatchCollisionRule(BENCH_SPEED_M_S, np.array(eps), dt=sim.control_dt_s)
+        return Loop(world, {}, team=BenchTeam(rule, height))
     robots = {i: BenchRobot(CollisionRule(BENCH_SPEED_M_S, e, dt=sim.control_dt_s), height)
-              for i, e in enumerate(epsilons(sim.n))}
+              for i, e in enumerate(eps)}
     return Loop(world, robots)
 
 
 def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROBOT_XML),
-              sensing: str = "auto", blocks: int = BLOCKS, physics: str = "dynamic") -> BenchResult:
+              sensing: str = "auto", blocks: int = BLOCKS, physics: str = "dynamic",
+              batched: bool = True) -> BenchResult:
     """Measure one robot count over ``sim_seconds`` of simulated time, the full loop in the
-    ``physics`` tier against bare dynamic physics (``mj_step``) of the same world.
+    ``physics`` tier (``batched``: the team's, else robot by robot) against bare dynamic
+    physics (``mj_step``) of the same world.
 
     The full loop and bare physics take turns in ``blocks`` equal stretches, so a slow
     spell of the machine weighs on both alike; each rate is over all its stretches.
@@ -83,7 +92,7 @@ def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROB
     if blocks < 1:
         raise MjswarmError(f"benchmark blocks must be >= 1, got {blocks}")
     sim = bench_world(n, robot_xml, sensing, physics)
-    loop = bench_loop(sim)
+    loop = bench_loop(sim, batched)
     loop.step()  # warm-up: one-time costs (loading the compiled ray loop) stay out of the timing
     bare = bench_world(n, robot_xml)
     m, d = bare.model, bare.data

@@ -26,6 +26,11 @@ between phases, never between two robots::
     for f in functions: f.after_step(loop)     # loop.stepped: the robots of this tick
     stop = any(f.should_stop(loop) for f in functions)
 
+A batched team (``Loop(..., team=...)``, :class:`~algorithms.batch.BatchController`) runs
+in the same phases: ``world.observe_all(robots)`` beside the nodes' observations, one
+``team.step_all(readings)`` after their steps, one ``world.act_all(robots, commands)``
+after their acts.
+
 Every observation of a tick is of one world state: acting changes nothing a later robot
 of the same tick observes (motion and messages take effect in ``world.step()``). A
 beacon is the exception by design: it is the vertex's store, and robots that stand on
@@ -44,6 +49,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from algorithms.batch import BatchCommand, BatchController, Readings
 from algorithms.robot import NOTHING, Command, Controller, Message, Observation
 from mjswarm.errors import MjswarmError
 from mjswarm.core.radio import Radio
@@ -96,6 +102,19 @@ class World(ABC):
     @abstractmethod
     def step(self) -> None:
         """Advance one control tick (physics, then the radio)."""
+
+    def observe_all(self, robots: Sequence[int]) -> Readings:
+        """The readings of this tick of every robot of ``robots``, one row each, for a
+        batched team (:class:`~algorithms.batch.BatchController`); by default from their
+        observations, robot by robot (a world with arrays of its own overrides this)."""
+        return Readings.from_observations([self.observe(i) for i in robots])
+
+    def act_all(self, robots: Sequence[int], commands: BatchCommand) -> None:
+        """Apply a batched team's commands, row by row as ``robots``; by default robot by
+        robot through :meth:`act`."""
+        for row, i in enumerate(robots):
+            v, omega, messages = commands.command(row)
+            self.act(i, Command(v, omega, None, messages))
 
     @abstractmethod
     def commanded_speeds(self) -> np.ndarray:
@@ -246,11 +265,20 @@ class Loop:
     mind, never its attributes. A robot's controller is reset (:meth:`Controller.reset`) when the
     robot enters the floor: before its first step, and again after each time it was
     off the floor.
+
+    A ``team`` (:class:`~algorithms.batch.BatchController`) drives every robot of the
+    world as arrays, in the same phases: its robots are sensed in one call
+    (:meth:`World.observe_all`) with the per-robot observations of the fixed nodes,
+    decided in one call after the nodes' controllers, and acted on in one call
+    (:meth:`World.act_all`) after them; ``controllers`` then holds the nodes' only, and
+    the team is reset with the robots that enter the floor.
     """
 
     def __init__(self, world: World, controllers: Mapping[int, Controller],
-                 functions: Iterable[LoopFunctions] = ()) -> None:
+                 functions: Iterable[LoopFunctions] = (),
+                 team: BatchController | None = None) -> None:
         self.world = world
+        self.team = team
         self.controllers: dict[int, Controller] = dict(controllers)
         self.functions: list[LoopFunctions] = []
         self.ticks = 0
@@ -298,20 +326,30 @@ class Loop:
         if self.halted:
             robots = [i for i in robots if i not in self.halted]
         self._enter(robots)
+        team, members = self.team, ()
+        if team is not None:  # the team's robots are stepped as arrays, the nodes one by one
+            members, robots = robots, []
         nodes = world.nodes
         if nodes:
             robots = [*nodes, *robots]
         observe, act = world.observe, world.act
         observations = [observe(i) for i in robots]
+        if team is not None:
+            readings = world.observe_all(members)
         if self._perceive:
             for i, o in zip(robots, observations):
                 controllers[i].perceive(o)
         commands = [controllers[i].step(o) for i, o in zip(robots, observations)]
+        if team is not None:
+            team_commands = team.step_all(readings)
         reports = []
         for i, command in zip(robots, commands):
             act(i, command)
             if command.events:
                 reports += [(i, event) for event in command.events]
+        if team is not None:
+            world.act_all(members, team_commands)
+            robots = [*robots, *members]
         self.stepped, self.reports = robots, reports
         world.step()
         self.ticks += 1
@@ -330,10 +368,13 @@ class Loop:
             self._on_floor = on_floor = {i for i in on_floor if world.on_floor(i)}
         if on_floor.issuperset(robots):
             return
-        for i in robots:
-            if i not in on_floor:
-                self.controllers[i].reset()
-                on_floor.add(i)
+        entering = [i for i in robots if i not in on_floor]
+        on_floor.update(entering)
+        if self.team is not None:
+            self.team.reset(entering)
+            return
+        for i in entering:
+            self.controllers[i].reset()
 
     def run(self, max_ticks: int | None = None,
             on_tick: Callable[[Loop], None] | None = None) -> list[Any]:

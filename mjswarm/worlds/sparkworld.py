@@ -30,9 +30,11 @@ from typing import Any
 
 import numpy as np
 
+from algorithms.batch import BatchCommand, Readings
 from algorithms.exploration.base import BeaconHandle
 from algorithms.robot import NOTHING, Command, Detection, Observation
 from mjswarm.core.bearing import BearingSensor
+from mjswarm.errors import MjswarmError
 from mjswarm.worlds.loop import World
 from mjswarm.core.simulation import Simulation
 
@@ -75,7 +77,8 @@ class SparkWorld(World):
         self._version = -1
         self._now_s = 0.0
         self._columns: tuple = ()
-        self._bearings: list[dict] | None = None
+        self._pairs: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # k, p, beta_kp
+        self._bearings: list[dict] | None = None  # the pairs as one dict per robot, when asked
 
     @property
     def time_s(self) -> float:
@@ -103,20 +106,58 @@ class SparkWorld(World):
         if i in self.fixed or i in self.docked:
             inbox, neighbors = self._inbox(i)
             return Observation(i, self.sim.time_s, inbox=inbox, neighbors=neighbors)
-        if self._version != self.sim.state_version:  # one read of every sensor per state
-            r = self.sim.readings()
+        r = self._sense()
+        if not self._columns:  # one conversion of the sensor record per state
             self._columns = (r["line"].tolist(), r["ir"].tolist(), r["encoder"].tolist(),
                              r["wheel_speed"].tolist(), r["battery"].tolist())
-            self._bearings = self.bearing.read() if self.bearing is not None else None
-            self._version = self.sim.state_version
-            self._now_s = self.sim.time_s
         line, ir, encoder, wheel_speed, battery = self._columns
         inbox, neighbors = self._inbox(i)
+        bearings = self.bearing_readings()[i] if self._pairs is not None else NOTHING
         return Observation(
             i, self._now_s, line[i], ir[i], encoder[i], wheel_speed[i], battery[i], None,
-            NOTHING if self._bearings is None else self._bearings[i],
-            self._ranges(i, neighbors) if self.ranging else NOTHING, inbox,
+            bearings, self._ranges(i, neighbors) if self.ranging else NOTHING, inbox,
             neighbors, self._beacon(i))
+
+    def _sense(self) -> np.ndarray:
+        """The simulation's sensor record now, and the bearing sensor's pairs read once
+        per state (what :meth:`observe` and :meth:`observe_all` both serve)."""
+        if self._version != self.sim.state_version:
+            self._pairs = self.bearing.read_pairs() if self.bearing is not None else None
+            self._bearings = None
+            self._columns = ()
+            self._version = self.sim.state_version
+            self._now_s = self.sim.time_s
+        return self.sim.readings()
+
+    def observe_all(self, robots) -> Readings:
+        """Every robot of ``robots``' readings at once, with no Python step per robot: the
+        simulation's sensor record, the bearing sensor's pairs, the radio's inboxes (a
+        team has no ranging, beacons or station links: those robots step one by one)."""
+        if self.ranging or self.beacon_at is not None or self.uplinks:
+            raise MjswarmError("a batched team has no ranging, beacons or station links")
+        k = np.asarray(robots, np.intp)
+        r = self._sense()[k]
+        row_of = np.full(self.n, -1, np.intp)
+        row_of[k] = np.arange(len(k))
+        seer, seen, beta = self._pairs if self._pairs is not None else (k[:0],) * 2 + (np.empty(0),)
+        row = row_of[seer]
+        order = np.flatnonzero(row >= 0)
+        order = order[np.lexsort((seen[order], row[order]))]
+        inbox = (self.radio.receive_all(robots) if self.radio is not None
+                 else ([], np.empty(0, np.intp), np.zeros(len(k) + 1, np.intp)))
+        return Readings(k, self._now_s, r["line"], r["ir"], r["encoder"], r["wheel_speed"],
+                        r["battery"], row[order], seen[order], beta[order], *inbox)
+
+    def act_all(self, robots, commands: BatchCommand) -> None:
+        """Apply a team's commands at once: the motion set-points, then its broadcasts."""
+        k = np.asarray(robots, np.intp)
+        v, w = np.array(self._v), np.array(self._w)
+        v[k], w[k] = commands.v_m_s, commands.omega_rad_s
+        self._v, self._w = v.tolist(), w.tolist()
+        if commands.broadcast is not None:
+            if self.radio is None:
+                raise MjswarmError("a team broadcast but the world has no radio")
+            self.radio.send_all(k[commands.broadcast].tolist(), commands.payload)
 
     def _beacon(self, i: int) -> BeaconHandle | None:
         """A handle on the beacon robot ``i`` may read now, good until the world steps."""
@@ -158,7 +199,11 @@ class SparkWorld(World):
     def bearing_readings(self) -> list[dict[int, float]]:
         """What every robot's bearing sensor reported at the last observed state (for
         recordings; empty without a bearing sensor)."""
-        return self._bearings if self._bearings is not None else [{} for _ in range(self.n)]
+        if self._pairs is None:
+            return [{} for _ in range(self.n)]
+        if self._bearings is None:
+            self._bearings = self.bearing.as_dicts(*self._pairs)
+        return self._bearings
 
     def act(self, i, command: Command) -> None:
         if i in self.fixed or i in self.docked:
