@@ -84,3 +84,16 @@ def test_compiling_without_sensors_gives_the_same_model(physics, sensing):
     for k in [k for k in dir(a) if not k.startswith("_") and isinstance(getattr(a, k, None), np.ndarray)]:
         assert np.array_equal(getattr(a, k), getattr(b, k), equal_nan=True), k
     assert a.opt.disableflags == b.opt.disableflags
+
+
+def test_a_big_world_has_room_for_every_body_pair_of_the_broadphase(monkeypatch):
+    """MuJoCo's collision stage takes an int per pair of bodies from the arena, near or
+    not (``mj_collision``'s ``nmaxpairs``): 10,000 dynamic robots ran out of a 2.6 GB arena
+    of 256 KB a robot. A world above the threshold sizes its arena for both."""
+    monkeypatch.setattr(world_module, "SIZED_ARENA_FROM_ROBOTS", 4)
+    spec = world_spec([Pose2D(i, 0.0) for i in range(5)])
+    bodies = len(spec.bodies)
+    assert bodies == 1 + 5 * 3  # the world, and each robot's chassis and two wheels
+    assert spec.memory == (world_module.ARENA_BYTES_PER_ROBOT * 5
+                           + world_module.BROADPHASE_BYTES_PER_PAIR * bodies * (bodies - 1) // 2)
+    assert world_spec([Pose2D(i, 0.0) for i in range(4)]).memory == -1  # MuJoCo's default
