@@ -156,7 +156,7 @@ class GraphWorld(World):
         if sense is None:
             sense = self._senses[(v, arrived_by)] = VertexSense(self.angles[v], arrived_by)
         # an observation per decision: built as the tuple it is (the named constructor
-        # costs a Python call more; tests/test_graph_world.py checks the fields)
+        # costs a Python call more; tests/test_exploration_world.py checks the fields)
         return _observation(Observation, (i, self._now, None, None, None, None, None, None,
                                           NOTHING, NOTHING, (), _NOBODY, handle, sense, None))
 
