@@ -8,11 +8,13 @@ A name is letters then digits, so it can always be split back unambiguously.
 
 from __future__ import annotations
 
+import functools
 import re
 
 _NAME = re.compile(r"([a-z]+)([1-9][0-9]*)")
 
 
+@functools.cache  # a robot names every beacon it drops with them
 def robot_letters(index: int) -> str:
     """Letters of the robot with 0-based ``index`` (0 -> ``a``, 25 -> ``z``, 26 -> ``aa``)."""
     if index < 0:
