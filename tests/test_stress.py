@@ -68,6 +68,13 @@ def test_dense_teams_at_top_speed_complete(run):
     assert passed(result), (result.ended_because, result.collisions, result.stopped_robots)
 
 
+def test_a_dense_team_at_top_speed_completes():
+    """The dense-team grid's fast representative: one robot for every 4 edges of a 5x5
+    lattice at 0.2 m/s (about 25 s of wall time)."""
+    result = StressRun("lattice:5x5", 10, 0.2, 0).run(max_sim_time_s=1200.0)
+    assert passed(result), (result.ended_because, result.collisions, result.stopped_robots)
+
+
 def test_the_dense_grid_gives_one_robot_for_every_7_5_and_4_edges():
     runs = dense_grid(arenas=("lattice:6x6",), speeds=(0.2,), seeds=(0,))
     assert [r.robots for r in runs] == [60 // 7, 60 // 5, 60 // 4]
