@@ -94,6 +94,13 @@ from algorithms.robot import Command, Controller, Message, Observation
 #: A relay stops this far short of where its requester stood on their lane (m): two body
 #: diameters, so that a requester backing out of a wall's shadow does not reach it.
 RELAY_SPACING_M = 0.3
+#: The creep (ours; issue 30's dense teams): a robot on its lane that the speed rule has
+#: held still this long (s) creeps on at ``CREEP_M_S`` (m/s) while its front IR sees
+#: nothing nearer than ``CREEP_GUARD_M`` (m, from the chassis rim; the IR's cutoff is
+#: 0.10 m, and at 5 cm/s the motors' 0.05 s ramp stops it within 3 mm).
+CREEP_AFTER_S = 5.0
+CREEP_M_S = 0.05
+CREEP_GUARD_M = 0.06
 
 
 class VertexCall(NamedTuple):
@@ -171,6 +178,7 @@ class Explorer(Controller):
         self._clear = True  # the vertex it goes to is clear of its previous holder
         self._events: list = []  # what it reports this tick (``Command.events``)
         self._said_speed = speed_m_s  # its speed as last reported
+        self._held_still_s = 0.0  # how long the speed rule has held it still on its lane
 
     def reset(self) -> None:
         """Put on a vertex centre (a launch): scan, then call the strategy."""
@@ -303,11 +311,13 @@ class Explorer(Controller):
         if self.rule is not None:
             if nav.on_lane:  # the rule governs edge traversals
                 fired = self.rule.activations
-                speed = self.rule.update(nav.lane_bearings(observation.bearings))
+                speed = self._creep(self.rule.update(nav.lane_bearings(observation.bearings)),
+                                    observation.ir_m)
                 if self.rule.activations != fired:
                     self._events.append(SpeedRuleFired(self.rule.activations - fired))
             else:
                 self.rule.forget_bearings()
+                self._held_still_s = 0.0
             # a vertex area it gives up is one it never backs into (``_retrace``)
             if self._leaving and nav.in_corridor:  # clear of the vertex it left
                 out.append(Message(LeftVertex(), STATION))
@@ -374,6 +384,31 @@ class Explorer(Controller):
         if self.table is not None:
             out["biconnected"] = float(self.table.is_doubly_connected())
         return out
+
+    def _creep(self, speed: float, ir_m) -> float:
+        """The rule's ``speed`` (m/s), or ``CREEP_M_S`` once the rule has held the robot
+        still on its lane for ``CREEP_AFTER_S`` and its front IR sees nothing within
+        ``CREEP_GUARD_M``.
+
+        Seed 003's rule stops a robot for one whose bearing stays in its same-lane cone
+        and does not change, and resumes when it changes. Bearings carry no range: a robot
+        standing on the centre of the vertex beyond the next, waiting for the vertex this
+        robot holds, can fall within the cone of a robot whose nose (and so its estimate of
+        its lane's direction, early on the lane) is a few degrees off, and then neither
+        ever moves (``lattice:6x6``, 8 robots, 0.15 m/s, seed 1: the cone was 2.6 degrees,
+        the robot seen at 2.5). A robot on its lane is the only one on that lane (vertex
+        entry, :mod:`mjswarm.experiments.stations`), so a long stop is such a phantom, and
+        creeping on, guarded by the front IR, breaks the wait: its own motion changes the
+        bearing, and the rule lets it go on or stops it anew. A body truly ahead is seen
+        by the IR first."""
+        if speed > 0.0:
+            self._held_still_s = 0.0
+            return speed
+        self._held_still_s += self.control_dt_s
+        front = ir_m[1] if ir_m is not None else math.nan
+        clear = math.isnan(front) or front > CREEP_GUARD_M
+        return min(CREEP_M_S, self.cruise_m_s) if (
+            self._held_still_s >= CREEP_AFTER_S and clear) else 0.0
 
     # -- events and vertex calls -----------------------------------------------------------
     def _on_events(self, observation: Observation, out: list[Message]) -> None:

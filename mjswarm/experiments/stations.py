@@ -41,6 +41,17 @@ behind it by the speed rule while it holds the vertex the first one waits for. T
 deadlock is not broken here; the team's stall verdict ends such a run (seen once, on
 ``arena2`` with 4 robots at 2 m, while rule 6 was being built).
 
+A wait that closes through the speed rule (issue 30's dense-team grid; ``lattice:6x6``,
+8 robots, 0.15 m/s, seed 1, stalled at 934 s): R4, on its lane from ``v4_2`` to ``v4_3``
+(holding ``v4_3``, still leaving ``v4_2``), was held still by the speed rule for R5,
+which stood on the centre of ``v4_4``, the vertex beyond, and waited for ``v4_3``; R3
+waited where its lane's wall ends for ``v4_2`` to be clear, and four more robots waited on
+centres for vertices those held. Bearings carry no range: R5 stood 2.5 degrees off R4's
+estimate of its lane, inside the rule's 2.6 degree cone. The stations cannot see that
+wait; the robot breaks it (:meth:`~algorithms.exploration.explorer.Explorer._creep`: a
+robot held still on its lane for 5 s creeps on, guarded by its front IR, since vertex
+entry leaves nobody else on its lane).
+
 Grants go in the order of the requests (then robot index), so a waiting robot is served
 before later ones. Ground truth used here, as the paper's station had it: the arena's
 edges at each vertex (:func:`mjswarm.arena.geometry.vertex_fans`).
