@@ -45,7 +45,7 @@ A wait that closes through the speed rule (issue 30's dense-team grid; ``lattice
 8 robots, 0.15 m/s, seed 1, stalled at 934 s): R4, on its lane from ``v4_2`` to ``v4_3``
 (holding ``v4_3``, still leaving ``v4_2``), was held still by the speed rule for R5,
 which stood on the centre of ``v4_4``, the vertex beyond, and waited for ``v4_3``; R3
-waited where its lane's wall ends for ``v4_2`` to be clear, and four more robots waited on
+waited where its lane's wall ends for ``v4_2`` to be clear, and five more robots waited on
 centres for vertices those held. Bearings carry no range: R5 stood 2.5 degrees off R4's
 estimate of its lane, inside the rule's 2.6 degree cone. The stations cannot see that
 wait; the robot breaks it (:meth:`~algorithms.exploration.explorer.Explorer._creep`: a
