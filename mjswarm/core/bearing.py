@@ -67,9 +67,10 @@ class BearingSensor:
         pairs = sim.neighbours.pairs(poses[:, :2], self.range_m)
         k = np.concatenate([pairs[:, 0], pairs[:, 1]])
         p = np.concatenate([pairs[:, 1], pairs[:, 0]])
-        diff = poses[p, :2] - poses[k, :2]
-        beta = np.arctan2(diff[:, 1], diff[:, 0]) - poses[k, 2]
-        near = np.abs(beta - 2 * np.pi * np.round(beta / (2 * np.pi))) <= self.fov_rad + FOV_MARGIN_RAD
+        x, y, yaw = poses.T
+        beta = np.arctan2(y[p] - y[k], x[p] - x[k]) - yaw[k]
+        near = np.flatnonzero(np.abs(beta - 2 * np.pi * np.round(beta / (2 * np.pi)))
+                              <= self.fov_rad + FOV_MARGIN_RAD)
         k, p, beta = k[near], p[near], beta[near]
         beta = np.arctan2(np.sin(beta), np.cos(beta))
         ahead = np.abs(beta) <= self.fov_rad

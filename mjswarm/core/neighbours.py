@@ -10,9 +10,10 @@ inclusive) proposes the pairs within ``r`` enlarged by ``CANDIDATE_SLACK`` relat
 exact test decides, so the tree's own rounding cannot add or lose a pair at exactly ``r``.
 
 The tree is built once per distinct positions (compared by value: about 3 us for 1000
-robots, where building the tree takes about 80 us and querying it 100 us) and each range's
-answer is kept until the positions change, so the second asker at the same positions
-costs a comparison.
+robots, where building the tree takes about 55 us and querying it 110 us; midpoint splits
+without shrinking the nodes to their points, which build and query 1000 robots about 40 us
+faster than scipy's default and propose the same pairs) and each range's answer is kept
+until the positions change, so the second asker at the same positions costs a comparison.
 """
 
 from __future__ import annotations
@@ -51,7 +52,7 @@ class Neighbours:
         if n < 2:
             return np.empty((0, 2), np.int64)
         if self._tree is None:
-            self._tree = cKDTree(self._xy)
+            self._tree = cKDTree(self._xy, balanced_tree=False, compact_nodes=False)
         near = self._tree.query_pairs(range_m * (1.0 + CANDIDATE_SLACK),
                                       output_type="ndarray").reshape(-1, 2)
         k, l = near[:, 0].astype(np.int64), near[:, 1].astype(np.int64)
