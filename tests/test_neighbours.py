@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
+from mjswarm.core import bearing as bearing_module
 from mjswarm.core.bearing import BearingSensor
 from mjswarm.core.neighbours import Neighbours
 from mjswarm.core.radio import Radio, sight_blocker
@@ -90,10 +91,12 @@ def test_the_shared_search_gives_bearings_and_links_as_separate_searches(seed):
     assert seen and links
 
 
+@pytest.mark.parametrize("quick_from", [0, bearing_module.QUICK_WRAP_FROM])
 @pytest.mark.parametrize("fov", [math.radians(60.0), math.pi / 2, math.pi])
-def test_bearings_at_the_edge_of_the_field_of_view_are_kept_as_before(fov):
+def test_bearings_at_the_edge_of_the_field_of_view_are_kept_as_before(monkeypatch, fov, quick_from):
     """Robot 1 within a few ulps, and a micro-radian, of robot 0's field-of-view edges
     (and of +-pi): the quick wrap that skips far pairs drops none the reading keeps."""
+    monkeypatch.setattr(bearing_module, "QUICK_WRAP_FROM", quick_from)
     sim = Simulation(world_spec([Pose2D(0.0, 0.0, 0.0), Pose2D(0.5, 0.0, 0.0)]))
     bearing = BearingSensor(sim, fov, 1.0)
     rng = np.random.default_rng(7)
