@@ -26,11 +26,13 @@ Choices the papers leave open:
   blocked. Distances are Euclidean over whatever coordinates the positions have (metres);
   the test is ``sum((p_i - p_j)**2) <= d_c**2`` in float64, and a robot with a non-finite
   coordinate has no links.
-* Relinking costs O(N + P) for N robots and P in-range pairs (O(N) at bounded density): a
-  k-d tree (``scipy.spatial.cKDTree.query_pairs``, itself inclusive) proposes the pairs
-  within a radius enlarged by 1e-9 relative, and the exact squared-distance test above
-  decides, so the tree's own rounding cannot add or lose a link at exactly d_c. The
-  blocker is called once per relink with every in-range pair, in robot order.
+* Relinking costs O(N + P) for N robots and P in-range pairs (O(N) at bounded density):
+  the pairs in range are :meth:`mjswarm.core.neighbours.Neighbours.pairs` (a k-d tree
+  proposes, the exact squared-distance test above decides, so the tree's own rounding
+  cannot add or lose a link at exactly d_c); an embodied world hands the radio its
+  simulation's search (``neighbours=sim.neighbours``), whose tree the bearing sensor
+  shares at the same positions. The blocker is called once per relink with every
+  in-range pair, in robot order.
 * ``send(..., to=j)`` is a broadcast that only robot ``j`` keeps (the papers' table
   exchange and reports): it costs one transmission and reaches ``j`` only if ``j`` is a
   neighbour. Counters count transmissions sent and copies received.
@@ -60,9 +62,8 @@ from typing import TYPE_CHECKING, Any
 
 import networkx as nx
 import numpy as np
-from scipy.spatial import cKDTree
-
 from algorithms.robot import NOTHING, Message
+from mjswarm.core.neighbours import Neighbours
 from mjswarm.errors import MjswarmError
 
 if TYPE_CHECKING:  # the embodied worlds' radio model (sight_blocker) asks the simulation
@@ -72,9 +73,6 @@ if TYPE_CHECKING:  # the embodied worlds' radio model (sight_blocker) asks the s
 #: every id is an int, else objects), a bool array with one entry per pair, True when i and
 #: j cannot hear each other (no line of sight).
 Blocker = Callable[[np.ndarray], np.ndarray]
-
-#: relative enlargement of the k-d tree's search radius over d_c (the exact test decides)
-_CANDIDATE_SLACK = 1e-9
 
 # ------------------------------------------------------------------ immutable payloads
 _ATOM, _SEQUENCE, _FIELDS, _HANDLE = range(4)
@@ -152,6 +150,8 @@ class Radio:
             relink with all in-range pairs.
         drop_prob: probability in [0, 1) that one copy of a message is lost.
         rng: numpy Generator or seed for the drops.
+        neighbours: the search for pairs in range (default the radio's own); a world
+            passes its simulation's, shared with the bearing sensor.
 
     Exactly one of ``range_m`` and ``edges`` must be given.
     """
@@ -165,6 +165,7 @@ class Radio:
         blocked: Blocker | None = None,
         drop_prob: float = 0.0,
         rng: np.random.Generator | int | None = None,
+        neighbours: Neighbours | None = None,
     ) -> None:
         self.robots: tuple[Hashable, ...] = tuple(robots)
         self._index: dict[Hashable, int] = {r: k for k, r in enumerate(self.robots)}
@@ -179,6 +180,7 @@ class Radio:
         _check_options(range_m, edges, drop_prob)
         self.range_m = range_m
         self.blocked = blocked
+        self._near = Neighbours() if neighbours is None else neighbours
         self.drop_prob = float(drop_prob)
         self._rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
         self._present: dict[Hashable, None] = dict.fromkeys(self.robots)
@@ -480,13 +482,9 @@ class Radio:
             rows = np.array([self._index[r] for r in self._present], dtype=np.intp)
         xy = self._xy[rows]
         finite = np.isfinite(xy).all(axis=1)
-        xy, rows = xy[finite], rows[finite]
-        near = cKDTree(xy).query_pairs(
-            self.range_m * (1.0 + _CANDIDATE_SLACK), output_type="ndarray"
-        ).reshape(-1, 2)
-        near = near[((xy[near[:, 0]] - xy[near[:, 1]]) ** 2).sum(axis=-1) <= self.range_m**2]
-        ij = rows[near]  # k < l: query_pairs gives i < j and ``rows`` increases
-        ij = ij[np.lexsort((ij[:, 1], ij[:, 0]))]
+        if not finite.all():
+            xy, rows = xy[finite], rows[finite]
+        ij = rows[self._near.pairs(xy, self.range_m)]  # sorted: ``rows`` increases
         if self.blocked is not None and len(ij):
             cut = np.asarray(self.blocked(self._ids[ij]), dtype=bool)
             if cut.shape != (len(ij),):

@@ -148,6 +148,7 @@ class RayCaster:
         self._cell_ids = np.arange(self._shape[0] * self._shape[1] + 1)
         self._cell_start = np.searchsorted(cells[order], self._cell_ids)
         self._candidates: dict[bytes | None, np.ndarray] = {}  # geomgroup -> geoms it may hit
+        self._binned: tuple[np.ndarray, ...] = (np.empty((0, 3)),)  # :meth:`_binned_robots`
 
     def _cells(self, xy: np.ndarray) -> np.ndarray:
         """Grid (ix, iy) of points, clipped to the grid."""
@@ -181,10 +182,7 @@ class RayCaster:
         if candidate is None:
             groups = np.ones(mujoco.mjNGROUP, bool) if key is None else np.asarray(geomgroup, bool)
             candidate = self._candidates[key] = self.visible & groups[self.group]
-        centres = d.xpos[self.robot_bodies]
-        cells = self._flat(self._cells(centres[:, :2]))
-        order = np.argsort(cells, kind="stable")
-        robot_start = np.searchsorted(cells[order], self._cell_ids)
+        centres, order, robot_start = self._binned_robots()
         if numba.get_num_threads() != self.threads:  # set once, not per call (see above)
             numba.set_num_threads(self.threads)
         _cast(np.ascontiguousarray(rays.origin, float), np.ascontiguousarray(rays.direction, float),
@@ -195,6 +193,17 @@ class RayCaster:
               robot_start, order, centres,
               self._robot_geom_start, self._robot_geoms, self.robot_radius_m, dist, geom)
         return dist, geom
+
+    def _binned_robots(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The robots' centres now (m), the robots sorted by grid cell and each cell's
+        start in that order; binned again only when a centre moved (the rangefinders and
+        the line of sight of one state, about 45 us a binning at 1000 robots, share one)."""
+        centres = self.data.xpos[self.robot_bodies]
+        if not np.array_equal(centres, self._binned[0]):
+            cells = self._flat(self._cells(centres[:, :2]))
+            order = np.argsort(cells, kind="stable")
+            self._binned = (centres, order, np.searchsorted(cells[order], self._cell_ids))
+        return self._binned
 
     def _flat(self, cells: np.ndarray) -> np.ndarray:
         return cells[:, 0] * self._shape[1] + cells[:, 1]

@@ -51,8 +51,7 @@ class LineOfSight:
 
     def __call__(self, k: np.ndarray, p: np.ndarray) -> np.ndarray:
         n = self.sim.n
-        k, p = np.asarray(k, np.int64), np.asarray(p, np.int64)
-        key = k * n + p
+        key = np.asarray(k, np.int64) * n + np.asarray(p, np.int64)
         if self._version != self.sim.state_version:  # a new state: nothing known yet
             self._version = self.sim.state_version
             self._keys, self._seen = np.empty(0, np.int64), np.empty(0, bool)
@@ -65,12 +64,12 @@ class LineOfSight:
                 return seen
         where = self._find(key)
         missing = where < 0
-        if missing.any():
-            new = np.unique(key[missing])
-            keys = np.concatenate([self._keys, new])
-            seen = np.concatenate([self._seen, self._cast(new // n, new % n)])
-            order = np.argsort(keys, kind="stable")
-            self._keys, self._seen = keys[order], seen[order]
+        if missing.any():  # cast the new pairs, each once, and merge them in key order
+            new = np.sort(key[missing])
+            new = new[np.concatenate([[True], new[1:] != new[:-1]])]
+            at = np.searchsorted(self._keys, new)
+            self._seen = np.insert(self._seen, at, self._cast(new // n, new % n))
+            self._keys = np.insert(self._keys, at, new)
             where = self._find(key)
         return self._seen[where]
 
@@ -104,13 +103,16 @@ class LineOfSight:
         ``|p - k| + R`` finds ``p`` if ``mj_ray`` would; coincident robots do not see
         each other."""
         sim = self.sim
-        poses = sim.poses()
-        vec = poses[p, :2] - poses[k, :2]
-        dist = np.hypot(vec[:, 0], vec[:, 1])
+        x, y, _ = sim.poses().T
+        dx, dy = x[p] - x[k], y[p] - y[k]
+        dist = np.hypot(dx, dy)
         apart = dist > 0
-        unit = np.column_stack([vec / np.where(apart, dist, 1.0)[:, None], np.zeros(len(k))])
+        scale = np.where(apart, dist, 1.0)
+        unit = np.zeros((len(k), 3))
+        unit[:, 0], unit[:, 1] = dx / scale, dy / scale
         unit[~apart, 0] = 1.0
-        start = np.column_stack([poses[k, :2], np.full(len(k), RAY_HEIGHT_M)])
+        start = np.full((len(k), 3), RAY_HEIGHT_M)
+        start[:, 0], start[:, 1] = x[k], y[k]
         self.rays_cast += len(k)
         geom = self._first_geoms(k, start, unit, dist, sim.robot_bodies[k])
         return apart & (geom >= 0) & (sim.geom_robot[geom] == p)

@@ -49,6 +49,7 @@ from mjswarm.core.robot import (
     WHEEL_SPEED_SENSORS,
     measure_geometry,
 )
+from mjswarm.core.neighbours import Neighbours
 from mjswarm.core.sight import LineOfSight
 from mjswarm.core.world import Pose2D, quiet_empty_prefix, yaw_quat
 
@@ -183,6 +184,9 @@ class Simulation:
         self.state_version = 0
         self._poses_version = -1
         self._sight: LineOfSight | None = None
+        #: pairs of robots within a range, one k-d tree per set of positions, shared by the
+        #: bearing sensor and the radio (:mod:`mjswarm.core.neighbours`)
+        self.neighbours = Neighbours()
         if sensing == "grid":
             m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
             mujoco.mj_kinematics(m, self.data)

@@ -67,7 +67,8 @@ def bench_loop(sim: Simulation, batched: bool = True) -> Loop:
     :class:`~algorithms.bench_robot.BenchTeam` for all (``batched``), else one
     :class:`~algorithms.bench_robot.BenchRobot` per robot (the reference: the same run)."""
     world = SparkWorld(sim, BearingSensor(sim))
-    world.attach_radio(Radio(range(sim.n), range_m=RADIO_RANGE_M, blocked=sight_blocker(sim)))
+    world.attach_radio(Radio(range(sim.n), range_m=RADIO_RANGE_M, blocked=sight_blocker(sim),
+                             neighbours=sim.neighbours))
     height, eps = sim.geometry.line_sensor_height_m, epsilons(sim.n)
     if batched:
         rule = BatchCollisionRule(BENCH_SPEED_M_S, np.array(eps), dt=sim.control_dt_s)

@@ -194,7 +194,8 @@ class EmbodiedExploration(LoopFunctions):
                                           range_m=config.radio_range_m,
                                           blocked=sight_blocker(
                                               self.sim, {**self.world.fixed, **self.world.docked},
-                                              BASE_MAST_M)))
+                                              BASE_MAST_M),
+                                          neighbours=self.sim.neighbours))
         return order
 
     def _build_robots(self) -> list[Explorer]:
