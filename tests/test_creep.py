@@ -1,5 +1,6 @@
 """The creep (issue 30): a robot the speed rule has held still on its lane for a long
-time creeps on, guarded by its front IR (algorithms/exploration/explorer.py)."""
+time creeps on, guarded by its front IR; and a robot waiting at its wall's end for the
+vertex ahead backs off (algorithms/exploration/explorer.py)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,13 @@ import math
 import pytest
 
 from algorithms.collision import CollisionRule
-from algorithms.exploration.explorer import CREEP_AFTER_S, CREEP_GUARD_M, CREEP_M_S, Explorer
+from algorithms.exploration.explorer import (
+    CREEP_AFTER_S,
+    CREEP_GUARD_M,
+    CREEP_M_S,
+    WAIT_BACKOFF_M,
+    Explorer,
+)
 from mjswarm.core.simulation import Simulation
 from mjswarm.core.world import Pose2D, world_spec
 from mjswarm.experiments.minds import make_minds
@@ -50,3 +57,19 @@ def test_the_phantom_wait_of_a_dense_team_ends():
     the first held (stations' docstring)."""
     result = StressRun("lattice:6x6", 8, 0.15, 1).run(max_sim_time_s=1500.0)
     assert passed(result), (result.ended_because, result.collisions, result.stopped_robots)
+
+
+def test_a_robot_waiting_at_its_wall_end_backs_off_its_stopping_overshoot(robot):
+    """It backs ``WAIT_BACKOFF_M`` from where it began to wait, slowly, then stands; a new
+    wait starts from where that one begins."""
+    odometry = robot.nav.odometry
+    robot._wait_from_m, odometry.distance_m = None, 2.0
+    assert robot._back_off() == -CREEP_M_S
+    odometry.distance_m = 2.0 + 0.01  # the stop's overshoot
+    assert robot._back_off() == -CREEP_M_S
+    odometry.distance_m = 2.0 - WAIT_BACKOFF_M + 0.001
+    assert robot._back_off() == -CREEP_M_S
+    odometry.distance_m = 2.0 - WAIT_BACKOFF_M
+    assert robot._back_off() == 0.0
+    robot._wait_from_m, odometry.distance_m = None, 5.0
+    assert robot._back_off() == -CREEP_M_S

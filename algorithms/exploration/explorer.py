@@ -101,6 +101,16 @@ RELAY_SPACING_M = 0.3
 CREEP_AFTER_S = 5.0
 CREEP_M_S = 0.05
 CREEP_GUARD_M = 0.06
+#: A robot that waits at its wall's end for the vertex ahead to clear (vertex entry) backs
+#: this far (m) along its lane, at ``CREEP_M_S``, from where it stopped (ours; issue 30's
+#: dense teams). The arena places the wall's end so that a robot waiting there stands
+#: 0.26 m from the vertex centre, clear of a robot leaving along a neighbouring edge
+#: (:data:`mjswarm.arena.geometry.VERTEX_CLEAR_RADIUS_M`); but the wall's end is seen
+#: after the IR's debounce and the stop takes the motors' ramp, and at 0.2 m/s robots
+#: stopped 0.236-0.239 m from the centre, where one touched a robot leaving 90 degrees
+#: away (``lattice:6x6``, 12 robots, 0.2 m/s, seed 2). The lane leads to the vertex the
+#: robot holds, so nobody is behind it on it.
+WAIT_BACKOFF_M = 0.04
 
 
 class VertexCall(NamedTuple):
@@ -179,6 +189,7 @@ class Explorer(Controller):
         self._events: list = []  # what it reports this tick (``Command.events``)
         self._said_speed = speed_m_s  # its speed as last reported
         self._held_still_s = 0.0  # how long the speed rule has held it still on its lane
+        self._wait_from_m: float | None = None  # odometry distance where it began to wait
 
     def reset(self) -> None:
         """Put on a vertex centre (a launch): scan, then call the strategy."""
@@ -331,6 +342,13 @@ class Explorer(Controller):
             # turns back in the area it arrived at backs out of it: that area is its own)
             if not self._clear and (nav.on_lane if self._turning else nav.at_vertex_area):
                 speed = 0.0
+                if nav.on_lane and not self._turning:
+                    back = self._back_off()
+                    if back:
+                        self.speed_m_s, self._held = 0.0, True
+                        return Command(back, 0.0, messages=tuple(out))
+            else:
+                self._wait_from_m = None
         self.speed_m_s = speed
         # held: the speed rule or vertex entry stops it, or it waits for its grant
         self._held = (v != 0.0 and speed == 0.0) or self._departure is not None
@@ -338,6 +356,16 @@ class Explorer(Controller):
             factor = speed / self.cruise_m_s
             v, w = v * factor, w * factor
         return Command(v, w, messages=tuple(out))
+
+    def _back_off(self) -> float:
+        """Its speed (m/s, negative: backwards) while it waits at its wall's end for the
+        vertex ahead: back along its lane until ``WAIT_BACKOFF_M`` from where it stopped."""
+        travelled = self.nav.odometry.distance_m
+        if self._wait_from_m is None:
+            self._wait_from_m = travelled
+        if travelled > self._wait_from_m - WAIT_BACKOFF_M:
+            return -min(CREEP_M_S, self.cruise_m_s)
+        return 0.0
 
     @property
     def _way(self) -> int:
