@@ -40,6 +40,15 @@ and every message is counted with the radio's. The protocol, from the robot's si
    asks for the way its mission takes. A grant names the request's angle, so that one
    overtaken by a withdrawal is known as such. A withdrawn swap leaves the other robot
    waiting, as before, until this one has left the vertex area it was given.
+6. Passing (ours, issue 30). A robot whose lane is blocked by a body that does not move
+   and is silent (:meth:`~algorithms.exploration.explorer.Explorer._stopped_body`) asks
+   to pass it on the opposite lane: :class:`PassRequest`. The opposite lane leads from
+   the vertex ahead ``w`` back to the vertex it left ``u``; from the request on, the
+   station of ``w`` lets nobody leave along it (``w`` to ``u`` requests wait), and it
+   answers :class:`PassGranted` once no robot is on its way along it (granted ``u``
+   from ``w`` and not yet on ``u``'s centre). The robot passes and, off the opposite
+   lane, sends :class:`PassDone`: the station opens the lane again. The pass is held
+   like a vertex area: one robot per lane, so nothing comes towards it.
 
 A station serves the beacon of its vertex only to the robot it granted (or launched
 there): a robot that arrives anywhere else finds no beacon and stops.
@@ -99,3 +108,15 @@ class Halted(NamedTuple):
     """Robot → station: I stopped for good (``reason``); release what I hold."""
 
     reason: str
+
+
+class PassRequest(NamedTuple):
+    """Robot → station: a body blocks my lane; hold the opposite lane for me to pass."""
+
+
+class PassGranted(NamedTuple):
+    """Station → robot: the opposite lane is empty and held for you: pass."""
+
+
+class PassDone(NamedTuple):
+    """Robot → station: I am off the opposite lane; open it again."""

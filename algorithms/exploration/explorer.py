@@ -76,6 +76,9 @@ from algorithms.exploration.entry import (
     EntryRequest,
     Halted,
     LeftVertex,
+    PassDone,
+    PassGranted,
+    PassRequest,
     TurnedBack,
     VertexClear,
     Withdraw,
@@ -111,6 +114,13 @@ CREEP_GUARD_M = 0.06
 #: away (``lattice:6x6``, 12 robots, 0.2 m/s, seed 2). The lane leads to the vertex the
 #: robot holds, so nobody is behind it on it.
 WAIT_BACKOFF_M = 0.04
+#: Passing a stopped body (ours, issue 30; :meth:`Explorer._stopped_body`): a body its
+#: front IR has seen within range, steady to ``PASS_STEADY_M`` (m: five times the 2 mm
+#: of the noisiest IR the noise grid runs), for ``PASS_AFTER_S`` (s) while the robot stood
+#: on its lane: twice the creep's wait, so that a phantom stop has been crept out of
+#: first.
+PASS_AFTER_S = 10.0
+PASS_STEADY_M = 0.01
 
 
 class VertexCall(NamedTuple):
@@ -190,6 +200,9 @@ class Explorer(Controller):
         self._said_speed = speed_m_s  # its speed as last reported
         self._held_still_s = 0.0  # how long the speed rule has held it still on its lane
         self._wait_from_m: float | None = None  # odometry distance where it began to wait
+        #: a body its front IR holds steady on its lane: since when (s) and its reading (m)
+        self._body: tuple[float, float] | None = None
+        self._pass_asked = False  # asked the stations to pass a body, not yet past it
 
     def reset(self) -> None:
         """Put on a vertex centre (a launch): scan, then call the strategy."""
@@ -349,6 +362,7 @@ class Explorer(Controller):
                         return Command(back, 0.0, messages=tuple(out))
             else:
                 self._wait_from_m = None
+            self._stopped_body(observation, speed, out)
         self.speed_m_s = speed
         # held: the speed rule or vertex entry stops it, or it waits for its grant
         self._held = (v != 0.0 and speed == 0.0) or self._departure is not None
@@ -366,6 +380,38 @@ class Explorer(Controller):
         if travelled > self._wait_from_m - WAIT_BACKOFF_M:
             return -min(CREEP_M_S, self.cruise_m_s)
         return 0.0
+
+    def _stopped_body(self, observation: Observation, speed: float,
+                      out: list[Message]) -> None:
+        """A body that stands on its lane for good, seen with its own senses: it asks to
+        pass it (:mod:`algorithms.exploration.entry`, step 6).
+
+        The body: its front IR's reading, held within ``PASS_STEADY_M`` for
+        ``PASS_AFTER_S`` while the robot stood on its lane, and no radio
+        neighbour's ranging within 30 degrees of its nose nearer than the body's far side
+        (with radios: the body is silent; without, nothing is). It cannot tell a dead
+        robot from any other body; it needs not to: vertex entry leaves nobody else on
+        its lane (:mod:`mjswarm.experiments.stations`), so a live robot never stands on
+        it (a speed-rule stop is its own, a queue waits on vertex centres); the one live
+        exception, a relay of connected exploration, beats on its radio, and tethered
+        robots do not pass (a walk back and a pass would share the opposite lane)."""
+        if self._pass_asked:
+            return
+        front = observation.ir_m[1] if observation.ir_m is not None else math.nan
+        if (self.tether is not None or self.calibration.body_radius_m is None
+                or not self.nav.on_lane or speed != 0.0 or math.isnan(front)):
+            self._body = None
+            return
+        now_s = observation.time_s
+        if self._body is None or abs(front - self._body[1]) > PASS_STEADY_M:
+            self._body = (now_s, front)
+            return
+        far_m = front + 4.0 * self.calibration.body_radius_m
+        if now_s - self._body[0] >= PASS_AFTER_S and not any(
+                d.range_m < far_m and abs(d.bearing_rad) < math.radians(30.0)
+                for d in observation.detections.values()):  # no radio answers from there
+            self._pass_asked, self._body = True, (self._body[0], front)
+            out.append(Message(PassRequest(), STATION))
 
     @property
     def _way(self) -> int:
@@ -457,6 +503,9 @@ class Explorer(Controller):
                                   nav.arrived_angle is not None, out, back)
             elif event.kind is NavEvent.LOST:
                 self._halt(str(event), out)
+            elif event.kind is NavEvent.PASSED:
+                self._pass_asked, self._body = False, None
+                out.append(Message(PassDone(), STATION))
         if (self._idle_since is not None
                 and observation.time_s - self._idle_since >= self.idle_wait_s):
             self._idle_since = None
@@ -527,6 +576,12 @@ class Explorer(Controller):
                 self._depart()
         elif isinstance(payload, VertexClear):
             self._clear = True
+        elif isinstance(payload, PassGranted):
+            if self.nav.on_lane and self._body is not None:
+                self.nav.pass_body(self._body[1])
+            else:  # no longer where it asked (it stopped for good): the lane is free
+                self._pass_asked = False
+                out.append(Message(PassDone(), STATION))
         elif isinstance(payload, EntryDenied):
             self._halt(payload.reason, out)
 

@@ -215,6 +215,30 @@ class FollowLine:
 
 
 @dataclass
+class FollowLineAlong:
+    """Follow a strip with ``line`` (a :class:`FollowLine`) until the robot has come
+    ``distance_m`` along ``heading`` (rad) from ``origin`` (x, y in m, odometry frame), or
+    until the strip ends (``line.ended_at_m`` is then set)."""
+
+    line: FollowLine
+    heading: float
+    origin: tuple[float, float]
+    distance_m: float
+
+    @property
+    def reached(self) -> bool:
+        """Whether it stopped because it came ``distance_m`` along ``heading``."""
+        return self.line.ended_at_m is None
+
+    def step(self, odo: Odometry, percept: Percept):
+        along = ((odo.x - self.origin[0]) * math.cos(self.heading)
+                 + (odo.y - self.origin[1]) * math.sin(self.heading))
+        if along >= self.distance_m:
+            return None
+        return self.line.step(odo, percept)
+
+
+@dataclass
 class FollowSpoke:
     """Follow a vertex spoke to its inner end, where the robot's centre sensor leaves it.
 

@@ -29,6 +29,13 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
   ``lattice:10x10`` at 0.2 m/s scanning one way, 7 alternating, both before re-anchoring);
 * **re-anchoring** (:meth:`Navigator.reanchor`): at a vertex whose beacon already stores
   angles, the caller rotates the robot's frame onto them (:func:`frame_offset`);
+* **passing** (:meth:`Navigator.pass_body`, ours, issue 30): round a body that stands on
+  its lane, on the opposite lane: step square across to it, follow that lane
+  until it is four body radii past where the body's front was, watching the corridor
+  wall on its right (the right IR sees it there as the left IR does from its own lane),
+  then sidestep back and follow its own lane on. If that wall ends during the pass (the
+  body stands near the corridor's end), it stays on the opposite lane and arrives from
+  it (the centre line is then to its left);
 * **leaving**: sidestep from the vertex centre to the left of the chosen spoke by
   ``lane_offset_m`` and find the lane ahead. (Not along the spoke first: two robots
   leaving the two ends of one edge at once would then face each other on its centre line,
@@ -51,6 +58,7 @@ from enum import Enum
 from algorithms.navigation.motions import (
     Drive,
     FollowLine,
+    FollowLineAlong,
     FollowSpoke,
     Scan,
     SeekLine,
@@ -89,6 +97,7 @@ class NavEvent(Enum):
     VERTEX_DETECTED = "vertex detected"  # the left wall ended
     ARRIVED = "arrived"  # on a vertex centre with its edges measured (also after a launch)
     LOST = "lost"  # lost its line: needs help (the paper's robots were placed back by hand)
+    PASSED = "passed a body"  # off the opposite lane after :meth:`Navigator.pass_body`
 
 
 @dataclass(frozen=True)
@@ -108,6 +117,7 @@ class NavigatorState(Enum):
     LEAVING = "leaving"
     ON_EDGE = "on_edge"
     ARRIVING = "arriving"
+    PASSING = "passing"  # round a body on its lane, on the opposite lane
     LOST = "lost"  # lost its line: needs help (the paper's robots were placed back by hand)
 
 
@@ -152,6 +162,10 @@ class Navigator:
         self._wall_seen = False
         self._wall_first_m: float | None = None  # odometry distance where its wall began
         self.vertex_detected = False
+        #: which side of its lane the edge's centre line lies: -1 right (its own lane),
+        #: +1 left (the opposite lane, passing a body)
+        self._centre_side = -1
+        self._watching = True  # watching the corridor wall (not while sidestepping)
 
     # ---------------------------------------------------------------- control
     def begin_at_vertex(self) -> None:
@@ -221,11 +235,45 @@ class Navigator:
         ])
         self.state = NavigatorState.ARRIVING
 
+    def pass_body(self, ahead_m: float) -> None:
+        """Pass a body standing ``ahead_m`` (m, the front IR's reading from its rim) ahead
+        on its lane, on the opposite lane (module docstring). Its centre then ends
+        ``ahead_m + 4 body_radius_m`` along the lane from where it starts: the body's
+        centre is ``ahead_m + 2 r`` ahead, and it steps back once a body diameter beyond
+        it. The steps across are square to the lane (:meth:`_sidestep`), so it passes a
+        round body of its own kind with ``2 lane_offset_m - 2 r`` to spare (3 cm for the
+        Spark V on 9 cm lane offsets). The caller makes sure the opposite lane carries
+        nobody meanwhile."""
+        if self.state is not NavigatorState.ON_EDGE or self.cal.body_radius_m is None:
+            raise RuntimeError("pass_body() needs the robot on its lane and its radius")
+        odo = self.odometry
+        heading = self._lane.direction(odo.theta)
+        follow = FollowLineAlong(FollowLine(self.speed), heading, (odo.x, odo.y),
+                                 ahead_m + 4.0 * self.cal.body_radius_m)
+        self._plan = deque([
+            *self._sidestep(heading, -1),
+            (SeekLine(heading, self.speed, self.conv.max_seek_m), self._found_opposite),
+            (follow, self._passed),
+        ])
+        self.state, self._watching = NavigatorState.PASSING, False
+
+    def _sidestep(self, heading: float, side: int) -> list:
+        """Cross to the other lane of its edge, to the left (side=+1) or right (-1) of
+        ``heading``, square to it: a turn in place, two lane offsets straight across, a
+        turn back. Unlike :meth:`_shift`'s diagonal it gains no ground along the lane, so
+        a round body however near ahead keeps its distance."""
+        across = heading + side * math.pi / 2.0
+        return [(Turn(across, self.turn_rate), None),
+                (Drive(2.0 * self.conv.lane_offset_m, across, self.speed), None),
+                (Turn(heading, self.turn_rate), None)]
+
     def update(self, percept: Percept) -> tuple[float, float]:
         """Advance one control tick; return the ``(v, omega)`` command (m/s, rad/s)."""
         self.odometry.update(percept.encoders)
         if self.state is NavigatorState.ON_EDGE:
-            self._watch_wall(percept)
+            self._watch_wall(percept.ir[0])
+        elif self.state is NavigatorState.PASSING and self._watching:
+            self._watch_wall(percept.ir[2])  # the corridor's other wall, seen from its lane
         while self._plan:
             motion, on_done = self._plan[0]
             command = motion.step(self.odometry, percept)
@@ -251,8 +299,10 @@ class Navigator:
 
     @property
     def in_corridor(self) -> bool:
-        """On an edge's lane and has seen its left wall (``min_wall_run_m`` of it)."""
-        return self.state is NavigatorState.ON_EDGE and self._wall_seen
+        """On an edge's lane (or passing on the opposite one) and has seen its corridor
+        wall (``min_wall_run_m`` of it)."""
+        return (self.state in (NavigatorState.ON_EDGE, NavigatorState.PASSING)
+                and self._wall_seen)
 
     @property
     def room_to_turn(self) -> bool:
@@ -260,7 +310,7 @@ class Navigator:
         the vertex area behind: the U-turn's sidestep carries it
         ``2 lane_offset_m / tan(60 deg)`` back, and it is at least ``min_wall_run_m`` more
         past where its wall began (a vertex area ends where its walls begin)."""
-        if not self.in_corridor:
+        if not (self.on_lane and self.in_corridor):
             return False
         back_m = 2.0 * self.conv.lane_offset_m / math.tan(SHIFT_ANGLE)
         return self.odometry.distance_m - self._wall_first_m >= back_m + self.conv.min_wall_run_m
@@ -293,8 +343,8 @@ class Navigator:
     def at_vertex_area(self) -> bool:
         """About to enter a vertex area: on the lane with the vertex detected (the left
         wall has ended), or already arriving."""
-        return ((self.state is NavigatorState.ON_EDGE and self.vertex_detected)
-                or self.state is NavigatorState.ARRIVING)
+        return ((self.state in (NavigatorState.ON_EDGE, NavigatorState.PASSING)
+                 and self.vertex_detected) or self.state is NavigatorState.ARRIVING)
 
     # ---------------------------------------------------------------- plans
     def _shift(self, heading: float, side: int, distance_m: float | None = None) -> list:
@@ -320,8 +370,44 @@ class Navigator:
         self._lane = FollowLine(self.speed)
         self._plan = deque([(self._lane, self._lane_ended)])
 
-    def _watch_wall(self, percept: Percept) -> None:
-        """Vertex detection: the left wall, once seen on this edge, disappears.
+    def _found_opposite(self, seek: SeekLine) -> None:
+        if seek.failed:
+            self._lose("no opposite lane beside the body it passes")
+            return
+        self._watching, self._wall_run_start = True, None
+
+    def _passed(self, follow: FollowLineAlong) -> None:
+        """Past the body: back onto its own lane, or (the corridor ended meanwhile) on
+        along the opposite lane to its end and the arrival from there."""
+        if follow.reached and not self.vertex_detected:
+            self._watching = False
+            self._plan = deque([
+                *self._sidestep(follow.heading, +1),
+                (SeekLine(follow.heading, self.speed, self.conv.max_seek_m), self._rejoined),
+            ])
+            return
+        if not self.vertex_detected:
+            self._lose("the opposite lane ended beside the body it passed")
+            return
+        self._lane, self._centre_side = follow.line, +1
+        self.events.append(NavigatorEvent(NavEvent.PASSED))
+        if follow.reached:  # on to the opposite lane's end
+            self._plan = deque([(follow.line, self._lane_ended)])
+        else:
+            self._lane_ended(follow.line)
+
+    def _rejoined(self, seek: SeekLine) -> None:
+        if seek.failed:
+            self._lose("its lane not found after passing a body")
+            return
+        self.state, self._watching, self._wall_run_start = NavigatorState.ON_EDGE, True, None
+        self._lane = FollowLine(self.speed)
+        self._plan = deque([(self._lane, self._lane_ended)])
+        self.events.append(NavigatorEvent(NavEvent.PASSED))
+
+    def _watch_wall(self, ir_m: float) -> None:
+        """Vertex detection: the left wall (``ir_m``: the left IR's reading; the right
+        one's while passing on the opposite lane), once seen on this edge, disappears.
 
         A wall is an IR reading within ``wall_tolerance_m`` of ``wall_distance_m``, the
         distance from the lane to the corridor wall: a robot passing on the left is seen
@@ -329,7 +415,7 @@ class Navigator:
         is gone once :class:`~.percept.WallWatch` has missed it for several readings in a
         row under IR noise (one noisy reading is no vertex)."""
         travelled = self.odometry.distance_m
-        if self.wall_watch(percept.ir[0]):
+        if self.wall_watch(ir_m):
             if self._wall_run_start is None:
                 self._wall_run_start = travelled
             if self._wall_first_m is None:
@@ -350,15 +436,16 @@ class Navigator:
             self._lose("lane ended with the wall still beside the robot" if self._wall_seen
                        else "lane ended before any corridor wall was seen (not its lane?)")
             return
-        self.state = NavigatorState.ARRIVING
+        self.state, self._watching = NavigatorState.ARRIVING, True
         heading = lane.direction(self.odometry.theta, last=None)
         self._lane_end = (self.odometry.x, self.odometry.y, heading)
         # the lane's direction in the odometry frame, carried to the scan: the incoming
         # spoke lies opposite it (a better reference than the angle measured at the last
         # vertex, which carries that scan's error)
         self._incoming = (heading + math.pi) % (2.0 * math.pi)
+        side, self._centre_side = self._centre_side, -1
         self._plan = deque([
-            *self._shift(heading, -1),
+            *self._shift(heading, side),
             (SeekLine(heading, self._approach_speed, self.conv.max_seek_m), self._found_spoke),
             (FollowSpoke(self._approach_speed), self._spoke_ended),
         ])

@@ -19,6 +19,7 @@ class RobotCalibration:
         line_ahead_m: how far ahead of the axle the line sensors look.
         max_speed_m_s: top forward speed.
         line_floor_m: what a line sensor reads over the bare floor (its height).
+        body_radius_m: its chassis radius (None: unknown; it then passes no body).
     """
 
     wheel_radius_m: float
@@ -26,6 +27,7 @@ class RobotCalibration:
     line_ahead_m: float
     max_speed_m_s: float
     line_floor_m: float = 0.02
+    body_radius_m: float | None = None
 
 
 class Odometry:

@@ -70,6 +70,9 @@ from algorithms.exploration.entry import (
     EntryRequest,
     Halted,
     LeftVertex,
+    PassDone,
+    PassGranted,
+    PassRequest,
     TurnedBack,
     VertexClear,
     Withdraw,
@@ -103,6 +106,10 @@ class VertexStations:
         self._fans = vertex_fans(spec)
         self.holder: dict[str, int] = {}
         self.requests: dict[int, Request] = {}
+        #: lanes held for a pass (:mod:`algorithms.exploration.entry`, step 6): robot ->
+        #: (from, to), the lane's ends in its direction of travel; nobody is granted ``to``
+        #: from ``from`` meanwhile
+        self.passes: dict[int, tuple[str, str]] = {}
 
     def edge_towards(self, vertex: str, angle: float) -> tuple[str, float]:
         """The neighbour of ``vertex`` along the edge nearest to ``angle`` (rad, common
@@ -128,7 +135,7 @@ class VertexStations:
         granted = []
         for robot in self._queue():
             to = self.requests[robot].to
-            if to not in self.holder:
+            if to not in self.holder and not self._on_held_lane(robot):
                 granted.append((robot, to))
                 self._give(robot)
         for robot in self._queue():
@@ -147,10 +154,16 @@ class VertexStations:
     def release_all(self, robot: int) -> list[str]:
         """``robot`` stopped for good: drop its request and every hold; returns the vertices."""
         self.requests.pop(robot, None)
+        self.passes.pop(robot, None)
         held = [v for v, r in self.holder.items() if r == robot]
         for v in held:
             del self.holder[v]
         return held
+
+    def _on_held_lane(self, robot: int) -> bool:
+        """Whether ``robot``'s request would take it along a lane held for a pass."""
+        request = self.requests[robot]
+        return (request.at, request.to) in self.passes.values()
 
     def _queue(self) -> list[int]:
         return sorted(self.requests, key=lambda r: (self.requests[r].since_s, r))
@@ -168,6 +181,8 @@ class VertexStations:
             request = self.requests.get(holder) if holder is not None else None
             if request is None or request.at != wanted:
                 return []  # the holder is not waiting on that centre: it will move on
+            if self._on_held_lane(chain[-1]):
+                return []  # it waits for a pass (which waits for no grant)
             if holder == robot:
                 return chain
             if holder in chain:
@@ -219,6 +234,8 @@ class StationService(LoopFunctions):
         self.asked: list[float | None] = [None] * k
         #: robots granted a vertex whose previous holder has not yet left it
         self.awaiting_clear: set[int] = set()
+        #: robots that asked to pass a body and have not yet been told to
+        self.pass_waiting: set[int] = set()
         self.loop: Loop | None = None
         world.beacon_at = self.beacon_at
         world.power_listeners.append(self._switched_off)
@@ -264,6 +281,11 @@ class StationService(LoopFunctions):
                 self.awaiting_clear.add(i)
             self.uplink.reply(i, EntryGranted(clear, self.asked[i]))
             loop.event(f"R{i + 1} granted {vertex}", i)
+        for i in sorted(self.pass_waiting):
+            if not self._on_the_way(*self.stations.passes[i]):
+                self.pass_waiting.discard(i)
+                self.uplink.reply(i, PassGranted())
+                loop.event(f"R{i + 1} passes a body", i)
 
     def after_step(self, loop: Loop) -> None:
         """Without vertex entry, a robot's vertex is the one its decision leads to."""
@@ -288,6 +310,24 @@ class StationService(LoopFunctions):
             self._tell_clear()
         elif isinstance(payload, Halted):
             self._release(i)
+        elif isinstance(payload, PassRequest):
+            # the opposite lane leads from the vertex ahead back to the one it left
+            self.stations.passes[i] = (self.target[i], self.came_from[i])
+            self.pass_waiting.add(i)
+        elif isinstance(payload, PassDone):
+            self.stations.passes.pop(i, None)
+            self.pass_waiting.discard(i)
+
+    def _on_the_way(self, start: str, end: str) -> bool:
+        """Whether some robot is on the lane from ``start`` to ``end``: it was granted
+        ``end`` leaving ``start`` and is not yet in ``end``'s area, as that station sees
+        (one switched off on the lane stays there: a pass beside it waits for good)."""
+        for j in range(self.world.n):
+            if self.came_from[j] == start and self.target[j] == end:
+                vertex, distance = self.nearest(j)
+                if vertex != end or distance >= VERTEX_CLEAR_RADIUS_M:
+                    return True
+        return False
 
     def _request(self, i: int, payload: EntryRequest) -> None:
         vertex = self.target[i]
@@ -347,6 +387,7 @@ class StationService(LoopFunctions):
             self.stations.occupy(i, vertex)
         self.leaving[i] = None
         self.awaiting_clear.discard(i)
+        self.pass_waiting.discard(i)
         self._tell_clear()
 
     def _tell_clear(self) -> None:

@@ -21,6 +21,7 @@ def calibration(geom: RobotGeometry) -> RobotCalibration:
         line_ahead_m=geom.line_sensor_ahead_m,
         max_speed_m_s=geom.max_speed_m_s,
         line_floor_m=geom.line_sensor_height_m,
+        body_radius_m=geom.body_radius_m,
     )
 
 

@@ -1,0 +1,93 @@
+"""Passing a robot that stopped on its lane (issue 30): the robot sees it with its own
+senses, the stations hold the opposite lane, and it passes there
+(algorithms/exploration/explorer.py, algorithms/navigation/navigator.py,
+mjswarm/experiments/stations.py)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from algorithms.collision import CollisionRule
+from algorithms.exploration.entry import STATION, PassRequest
+from algorithms.exploration.explorer import PASS_AFTER_S, PASS_STEADY_M, Explorer
+from algorithms.navigation import NavEvent, NavigatorState
+from algorithms.robot import Detection, Observation
+from mjswarm.arena import load_arena
+from mjswarm.core.simulation import Simulation
+from mjswarm.core.world import Pose2D, world_spec
+from mjswarm.experiments.embodied import EmbodiedConfig
+from mjswarm.experiments.exploration import EmbodiedExploration
+from mjswarm.experiments.faults import parse_fault
+from mjswarm.experiments.minds import make_minds
+from mjswarm.experiments.stations import VertexStations
+from mjswarm.worlds.navigation import calibration, conventions
+
+DT_S = 0.02
+
+
+def explorer() -> Explorer:
+    geometry = Simulation(world_spec([Pose2D(0.0, 0.0)])).geometry
+    robot = Explorer(make_minds("incidence-dfs", 1)[0], calibration(geometry),
+                     conventions(geometry), 0.15, CollisionRule(0.15, 1e-6, dt=DT_S),
+                     control_dt_s=DT_S)
+    robot.nav.state = NavigatorState.ON_EDGE  # on its lane
+    return robot
+
+
+def asks(robot: Explorer, seconds: float, fronts, detections=()) -> float | None:
+    """Stand ``seconds`` on its lane with the front IR reading ``fronts(t)`` (m); when (s)
+    it asked to pass, or None."""
+    for tick in range(round(seconds / DT_S)):
+        t = tick * DT_S
+        out = []
+        seen = {j: d for j, d in enumerate(detections)}
+        robot._stopped_body(Observation(0, t, ir_m=(math.nan, fronts(t), math.nan),
+                                        detections=seen), 0.0, out)
+        if any(isinstance(m.payload, PassRequest) and m.to == STATION for m in out):
+            return t
+    return None
+
+
+def test_a_steady_silent_body_ahead_is_passed_after_the_wait():
+    assert asks(explorer(), PASS_AFTER_S + 1.0, lambda t: 0.06) == pytest.approx(
+        PASS_AFTER_S, abs=DT_S)
+
+
+def test_a_body_that_moves_or_answers_on_the_radio_is_not_passed():
+    moving = asks(explorer(), 3 * PASS_AFTER_S, lambda t: 0.02 + (t % 4.0) * PASS_STEADY_M)
+    assert moving is None  # it shifts by more than PASS_STEADY_M every few seconds
+    alive = asks(explorer(), 2 * PASS_AFTER_S, lambda t: 0.06,
+                 detections=[Detection(0.06 + 0.15, math.radians(3.0))])
+    assert alive is None
+    beside = asks(explorer(), 2 * PASS_AFTER_S, lambda t: 0.06,
+                  detections=[Detection(0.2, math.radians(80.0))])  # a neighbour aside
+    assert beside == pytest.approx(PASS_AFTER_S, abs=DT_S)
+    assert asks(explorer(), 2 * PASS_AFTER_S, lambda t: math.nan) is None  # nothing there
+
+
+def test_a_held_lane_is_granted_to_nobody_and_closes_no_cycle():
+    stations = VertexStations(load_arena("arena2"))
+    stations.passes[9] = ("v4", "v3")  # robot 9 passes a body on the lane v4 -> v3
+    stations.occupy(0, "v4")
+    stations.occupy(1, "v3")
+    stations.request(0, "v4", "v3", 1.0)  # a swap of the edge's ends: a closed cycle ...
+    stations.request(1, "v3", "v4", 2.0)
+    assert stations.grant() == []  # ... but one of its lanes is held
+    stations.passes.pop(9)
+    assert sorted(stations.grant()) == [(0, "v3"), (1, "v4")]
+
+
+def test_a_robot_passes_a_dead_one_and_the_team_completes_the_true_map():
+    """``arena2``, 4 robots: R1 fails at 90 s at the start of its corridor from v3 to v4;
+    the robot sent along that edge next passes it (before passing, the run stalled)."""
+    spec = load_arena("arena2")
+    config = EmbodiedConfig(faults=[parse_fault("robot:1@90")])
+    run = EmbodiedExploration(spec, make_minds("incidence-dfs", 4, 0), config, 0)
+    result = run.run()
+    assert result.completed and result.map_correct, result.ended_because
+    assert result.collisions == 0
+    passes = [i for i, robot in enumerate(run.robots)
+              if any(e.kind is NavEvent.PASSED for e in robot.nav.events)]
+    assert passes and 0 not in passes
