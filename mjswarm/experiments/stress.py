@@ -16,6 +16,13 @@ robots' odometry heading stays within ``MAX_HEADING_ERROR_DEG`` of the truth.
 The dense-team grid (issue 30, ``--dense``): lattices, a hexagonal lattice and a random
 planar graph with one robot for every 7, 5 and 4 edges, at 0.15 and 0.2 m/s, three seeds;
 every run must pass as the stress grid's do.
+
+The dead-robot grid (issue 30, ``--dead``): one robot fails (``--fault robot:I@T``) on
+trees, the paper's arenas, a lattice and a random planar graph, teams of 2, 4 and 8,
+fault times from before the launch to half-way through a robot's share of the work,
+speeds 0.05-0.2 m/s in turn, both physics tiers. A run passes when it ends completed
+with the true map or with everything still reachable mapped and the rest named, no
+robot but the failed one stopped, and no contact.
 """
 
 from __future__ import annotations
@@ -32,6 +39,7 @@ from tqdm import tqdm
 
 from mjswarm.arena import ArenaSpec, load_arena, parse_arena_spec
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedResult, explore_embodied
+from mjswarm.experiments.faults import parse_fault
 
 #: Issue 13's first report: one robot arriving at v1, whose edges are 67.5 degrees
 #: apart, was carried out along a neighbouring spoke.
@@ -104,9 +112,18 @@ DENSE_SPEEDS_M_S = (0.15, 0.2)
 DENSE_SAMPLE = {"edges_per_robot": (5, 4), "speeds": (0.2,), "seeds": (0,)}
 
 
+#: Issue 30's dead-robot grid: arenas, teams, speeds (m/s, taken in turn) and fault times
+#: as fractions of a robot's share of the work (its ``E / K`` edges, each a traversal of
+#: the mean edge at the run's speed and a scan's full turn at 1 rad/s).
+DEAD_ARENAS = ("tree3", "tree4", "arena1", "arena2", "lattice:4x4", "random-planar:12:2")
+DEAD_TEAMS = (2, 4, 8)
+DEAD_SPEEDS_M_S = (0.05, 0.1, 0.15, 0.2)
+DEAD_FRACTIONS = (0.0, 0.15, 0.4)
+
+
 @dataclass(frozen=True)
 class StressRun:
-    """One cell of the grid."""
+    """One cell of the grid (``fault``: a ``--fault`` text, "" for none)."""
 
     arena: str
     robots: int
@@ -114,6 +131,7 @@ class StressRun:
     seed: int | None
     noise: Noise = Noise()
     physics: str = "dynamic"
+    fault: str = ""
 
     def spec(self) -> ArenaSpec:
         if self.arena == ISSUE_13_FAN["name"]:
@@ -125,7 +143,8 @@ class StressRun:
         config = EmbodiedConfig(speed_m_s=self.speed_m_s, max_sim_time_s=max_sim_time_s,
                                 line_noise_m=n.line_m, ir_noise_m=n.ir_m,
                                 bearing_noise_deg=n.bearing_deg, wheel_slip=n.wheel_slip,
-                                physics=self.physics)
+                                physics=self.physics,
+                                faults=[parse_fault(self.fault)] if self.fault else [])
         return explore_embodied(self.spec(), self.robots, config=config, seed=self.seed)
 
 
@@ -158,10 +177,33 @@ def dense_grid(arenas=DENSE_ARENAS, edges_per_robot=DENSE_EDGES_PER_ROBOT,
     return runs
 
 
+def dead_grid(arenas=DEAD_ARENAS, teams=DEAD_TEAMS, fractions=DEAD_FRACTIONS,
+              physics=PHYSICS, seeds=(0,)) -> list[StressRun]:
+    """Issue 30's dead-robot grid: in every arena, team (no larger than the arena's edge
+    count), fault time, tier and seed, robot ``1 + (cell number) mod K`` fails; speeds
+    go round ``DEAD_SPEEDS_M_S`` cell by cell."""
+    runs = []
+    for arena in arenas:
+        spec = StressRun(arena, 1, 0.05, 0).spec()
+        edge_m = sum(math.dist(spec.vertices[u], spec.vertices[v])
+                     for u, v in spec.edges) / len(spec.edges)
+        for k in (k for k in teams if k <= len(spec.edges)):
+            for fraction in fractions:
+                for tier in physics:
+                    for seed in seeds:
+                        cell = len(runs)
+                        v = DEAD_SPEEDS_M_S[cell % len(DEAD_SPEEDS_M_S)]
+                        share_s = len(spec.edges) / k * (edge_m / v + 2.0 * math.pi)
+                        fault = f"robot:{1 + cell % k}@{fraction * share_s:.0f}"
+                        runs.append(StressRun(arena, k, v, seed, physics=tier, fault=fault))
+    return runs
+
+
 def passed(result: EmbodiedResult, max_heading_error_deg: float = math.inf) -> bool:
-    """The grid's criterion: complete, true map, nobody stopped, no contact (and, for
-    the noise grid, ``MAX_HEADING_ERROR_DEG``)."""
-    return (result.completed and result.map_correct and not result.stopped_robots
+    """The grid's criterion: complete, true map, nobody stopped (but robots failed by a
+    fault), no contact (and, for the noise grid, ``MAX_HEADING_ERROR_DEG``)."""
+    stopped = [s for s in result.stopped_robots if not s["reason"].startswith("failed (fault")]
+    return (result.completed and result.map_correct and not stopped
             and result.collisions == 0 and result.heading_error_deg <= max_heading_error_deg)
 
 
@@ -184,7 +226,8 @@ def run_grid(runs: list[StressRun], workers: int, log=None,
             done.append((run, result, wall))
             if log is not None:
                 print(f"{run.arena} k={run.robots} v={run.speed_m_s:g} {run.noise} "
-                      f"{run.physics} seed={run.seed}: {result.ended_because} "
+                      f"{run.physics} seed={run.seed} fault={run.fault or 'none'}: "
+                      f"{result.ended_because} "
                       f"map={result.map_correct} contacts={result.collisions} "
                       f"stopped={len(result.stopped_robots)} "
                       f"heading={result.heading_error_deg:.1f} "
@@ -248,6 +291,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--dense", action="store_true",
                         help="run issue 30's dense-team grid instead (one robot for every "
                              "7, 5 and 4 edges, 0.15 and 0.2 m/s, three seeds: 90 runs)")
+    parser.add_argument("--dead", action="store_true",
+                        help="run issue 30's dead-robot grid instead (one robot fails; "
+                             "trees, paper arenas, a lattice, a random planar graph; teams "
+                             "of 2, 4 and 8; both physics tiers)")
     parser.add_argument("--sample", action="store_true",
                         help="with --noise: only 0.05 and 0.2 m/s, teams of 4 and one seed "
                              "(140 runs); with --dense: one robot for every 5 and 4 edges "
@@ -259,8 +306,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="with --noise: only the levels with wheel slip (alone, and "
                              "with every noise together)")
     args = parser.parse_args(argv)
-    if args.noise and args.dense:
-        parser.error("choose one of --noise and --dense")
+    if args.noise + args.dense + args.dead > 1:
+        parser.error("choose one of --noise, --dense and --dead")
     if (args.only_slip or args.slip != GRID_SLIP) and not args.noise:
         parser.error("--slip and --only-slip need --noise")
     if args.sample and not (args.noise or args.dense):
@@ -282,6 +329,10 @@ def main(argv: list[str] | None = None) -> int:
         if args.seeds is not None:
             options["seeds"] = range(args.seeds)
         runs, heading = dense_grid(arenas=arenas, **options), math.inf
+    elif args.dead:
+        arenas = DEAD_ARENAS if args.arenas is None else args.arenas.split(",")
+        runs = dead_grid(arenas=arenas, seeds=range(args.seeds or 1))
+        heading = math.inf
     else:
         arenas = ARENAS if args.arenas is None else args.arenas.split(",")
         runs, heading = grid(arenas=arenas, seeds=range(args.seeds or 1)), math.inf
