@@ -94,14 +94,17 @@ class GraphWorld(World):
             self.duration[(u, v)] = self.duration[(v, u)] = 1 if edge_time == "unit" else length / mean
         #: The true edge set, as sorted vertex pairs (metrics only).
         self.edges = {tuple(sorted(e)) for e in graph.edges}
-        #: vertex -> {angle: (neighbour, duration, angle of the edge at the neighbour)}: the
-        #: moves of :meth:`act`, worked out once for every run of the world.
-        self._exits: dict[str, dict[float, tuple[str, float, float]]] = {v: {} for v in graph}
+        #: vertex -> what a robot senses there when it has not moved since its last call
+        #: (at the start, after idling), made once
+        self._resting = {v: VertexSense(self.angles[v], None) for v in graph}
+        #: vertex -> {angle: (neighbour, duration, what the robot senses at the neighbour)}:
+        #: the moves of :meth:`act`, worked out once for every run of the world.
+        self._exits: dict[str, dict[float, tuple[str, float, VertexSense]]] = {
+            v: {} for v in graph}
         for (v, a), u in self.towards.items():
-            self._exits[v][a] = (u, self.duration[(v, u)], self.angle_of[(u, v)])
+            self._exits[v][a] = (u, self.duration[(v, u)],
+                                 VertexSense(self.angles[u], self.angle_of[(u, v)]))
         self.uplinks = {}
-        #: (vertex, angle arrived by) -> what a robot senses there, made once
-        self._senses: dict[tuple[str, float | None], VertexSense] = {}
         self.reset(0)
 
     def reset(self, n_robots: int) -> None:
@@ -112,7 +115,9 @@ class GraphWorld(World):
         #: the vertex each robot stands on, or is travelling to, and when it gets there
         self.at = [self.root] * n_robots
         self.arrival = [0] * n_robots
-        self._arrived_by: list[float | None] = [None] * n_robots
+        #: what each robot senses at its next call (the vertex it goes to, and the edge
+        #: it arrives by), set when it acts
+        self._sense = [self._resting[self.root]] * n_robots
         self._events = [(0, -i) for i in range(n_robots)]
         heapq.heapify(self._events)
         self._unit = self.edge_time == "unit"
@@ -149,32 +154,28 @@ class GraphWorld(World):
         return self.n
 
     def observe(self, i: int) -> Observation:
-        v, arrived_by = self.at[i], self._arrived_by[i]
-        handle = BeaconHandle(self.beacons[v])
+        handle = BeaconHandle(self.beacons[self.at[i]])
         self._handles.append(handle)
-        sense = self._senses.get((v, arrived_by))
-        if sense is None:
-            sense = self._senses[(v, arrived_by)] = VertexSense(self.angles[v], arrived_by)
         # an observation per decision: built as the tuple it is (the named constructor
         # costs a Python call more; tests/test_exploration_world.py checks the fields)
         return _observation(Observation, (i, self._now, None, None, None, None, None, None,
-                                          NOTHING, NOTHING, (), _NOBODY, handle, sense, None))
+                                          NOTHING, NOTHING, (), _NOBODY, handle,
+                                          self._sense[i], None))
 
     def act(self, i: int, command: Command) -> None:
         """Leave along ``command.edge_rad`` (the nearest edge), or idle one time unit."""
-        now = self._now
+        now, v = self._now, self.at[i]
         if command.edge_rad is None:
-            self._arrived_by[i] = None
+            self._sense[i] = self._resting[v]
             heapq.heappush(self._events, (now + 1, -i))
             return
-        v = self.at[i]
-        u, duration, back = (self._exits[v].get(command.edge_rad)
-                             or self.nearest_exit(v, command.edge_rad))
+        u, duration, sense = (self._exits[v].get(command.edge_rad)
+                              or self.nearest_exit(v, command.edge_rad))
         # times are whole steps with unit edges; with length-proportional edges they are
         # rounded to 1e-9 time units, so that arrivals equal up to rounding errors are
         # simultaneous (and handled in robot order)
         done_at = now + duration if self._unit else round(now + duration, 9)
-        self.at[i], self._arrived_by[i], self.arrival[i] = u, back, done_at
+        self.at[i], self._sense[i], self.arrival[i] = u, sense, done_at
         heapq.heappush(self._events, (done_at, -i))
 
     def step(self) -> None:
@@ -191,8 +192,8 @@ class GraphWorld(World):
     def commanded_speeds(self) -> np.ndarray:
         return np.zeros(self.n)
 
-    def nearest_exit(self, vertex: str, angle: float) -> tuple[str, float, float]:
+    def nearest_exit(self, vertex: str, angle: float) -> tuple[str, float, VertexSense]:
         """The move along the edge at ``vertex`` nearest to ``angle``: the neighbour, the
-        duration and the edge's angle at the neighbour."""
+        duration and what the robot senses on arriving there."""
         best = min(self.angles[vertex], key=lambda a: angle_gap(a, angle))
         return self._exits[vertex][best]
