@@ -207,3 +207,41 @@ def test_no_route_leaves_by_a_blocked_end_and_the_reach_stops_there():
     # its own ends finished but the root out of reach: it never declares
     beyond = m.block(("a2", PI)).block(("a2", TWO))
     assert beyond.reach("a2") == {"a2"} and not beyond.is_complete("a2", "a1")
+
+
+# -- embodied -----------------------------------------------------------------------------
+
+def test_embodied_robot_dying_on_a_vertex_centre_leaves_the_reachable_part_completed():
+    """arena2, 3 robots (kinematic tier): R2 is switched off at 150 s on the centre of v6
+    (it stands there from 144 s to 159 s), closing v6. A robot that asks for v6 is
+    answered EntryBlocked, marks the edge and decides anew; the team declares completion
+    of the part reachable from the root, names the four edges beyond, with 0 contacts."""
+    from mjswarm.experiments.embodied import EmbodiedConfig
+    from mjswarm.experiments.exploration import EmbodiedExploration
+    from mjswarm.experiments.faults import parse_fault
+    from algorithms.exploration.entry import EntryBlocked
+    from mjswarm.cli.explore import summary
+
+    spec = load_arena("arena2")
+    run = EmbodiedExploration(spec, make_minds("incidence-dfs", 3, None), EmbodiedConfig(
+        physics="kinematic", faults=[parse_fault("robot:2@150")]))
+    answers = []
+    reply = run.uplink.reply
+    run.uplink.reply = lambda i, payload: (answers.append((i, payload)), reply(i, payload))[1]
+    result = run.run()
+    assert result.ended_because == "completed reachable part"
+    assert result.collisions == 0
+    assert result.closed_vertices == [{"vertex": "v6", "robot": 2, "at_s": 150.0}]
+    beyond = {("v10", "v11"), ("v10", "v12"), ("v10", "v6"), ("v3", "v6")}
+    assert {tuple(e["edge"]) for e in result.unreachable_edges} == beyond
+    assert all("v6 closed by R2 stopped in its area at 150.0 s" in e["why"]
+               for e in result.unreachable_edges)
+    true = {tuple(sorted(e)) for e in spec.edges}
+    assert set(result.map_edges) == true - beyond and result.map_correct
+    assert any(type(p) is EntryBlocked and i != 1 for i, p in answers)
+    assert [s["robot"] for s in result.stopped_robots] == [2]  # nobody else stopped
+    d = result.to_dict()
+    d["world"], d["recording"], d["video"] = "embodied", None, None
+    text = summary(d)
+    assert "completed the reachable part: R" in text
+    assert "unreachable: v3-v6: vertex v6 closed by R2 stopped in its area at 150.0 s" in text

@@ -128,7 +128,9 @@ class FrontierExplorer(MapStrategy):
         selected, m = self.queue[-1], self.matrix
         if self.queue[0][0] != self.here or m.status(selected) == COMPLETED:
             return False
-        if m.any_blocked and any(map(m.is_blocked, self.queue)):
+        # the matrix's blocked bit set, read directly: 0 but with closed vertices, and this
+        # runs at every vertex on the way (the graph world's hot path)
+        if m._blocked and any(map(m.is_blocked, self.queue)):
             return False
         if self.reselect == "completed" or before is None:
             return True
@@ -182,7 +184,7 @@ class IncidenceDFS(FrontierExplorer):
         (``Eu(Rk)``); else the nearest out edge (``Eo(Rk)``); None if none is in reach."""
         stack, m = self.my_unexplored, self.matrix
         status = m.status
-        if m.any_blocked:
+        if m._blocked:  # as in ``_keep``
             reach = m.reach(self.here)
             while stack and (status(stack[-1]) != UNEXPLORED or m.is_blocked(stack[-1])
                              or stack[-1][0] not in reach):

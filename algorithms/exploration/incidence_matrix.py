@@ -358,8 +358,9 @@ class IncidenceMatrix:
 
     def unexplored(self) -> list[End]:
         """``Eu``: unexplored ends (blocked ones left out), in row order then angle order."""
-        row_ends = self.numbering.row_ends
-        taken = self._completed | self._out | self._blocked
+        row_ends, taken = self.numbering.row_ends, self._completed | self._out
+        if self._blocked:
+            taken |= self._blocked
         return [(tag, a) for tag in self.rows for a, _, bit in row_ends[tag] if not taken & bit]
 
     def unexplored_at(self, tag: str) -> list[float]:
@@ -368,7 +369,9 @@ class IncidenceMatrix:
         n = self.numbering
         if not self._tags & n.tag_bit.get(tag, 0):
             return []
-        taken = self._completed | self._out | self._blocked
+        taken = self._completed | self._out
+        if self._blocked:
+            taken |= self._blocked
         return [a for a, _, bit in n.row_ends[tag] if not taken & bit]
 
     def completed_edges(self) -> list[tuple[End, End]]:
@@ -601,7 +604,8 @@ def _union(a: IncidenceMatrix, b: IncidenceMatrix) -> IncidenceMatrix:
 def _contains(a: IncidenceMatrix, b: IncidenceMatrix) -> bool:
     """True if every entry of ``b`` is in ``a`` with at least ``b``'s status (both of one
     numbering)."""
-    if b._tags & ~a._tags or b._completed & ~a._completed or b._blocked & ~a._blocked:
+    if b._tags & ~a._tags or b._completed & ~a._completed or (
+            b._blocked and b._blocked & ~a._blocked):
         return False
     missing = b._selections & ~a._selections
     if missing:  # selections of ends a knows as completed do not count
