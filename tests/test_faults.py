@@ -67,15 +67,18 @@ def test_a_dead_robot_stops_and_the_others_finish_with_the_true_map():
     assert result.traversals_per_robot[2] == 0
 
 
-def test_a_body_that_blocks_the_way_ends_the_run_early_as_stalled():
-    """R2 dies on the lane R1 later needs: R1 waits behind it (the speed rule), nobody
-    reaches a vertex any more, and the run ends as stalled long before --max-time."""
+def test_a_body_in_a_vertex_area_closes_it_and_the_reachable_part_is_completed():
+    """R2 dies in the area of v2 (it ended ``stalled`` before issue 30): v2 is closed, R1
+    is answered EntryBlocked when it asks for it, finishes the rest and declares completion
+    of the reachable part, naming the two edges at v2."""
     config = EmbodiedConfig(speed_m_s=0.1, faults=[parse_fault("robot:2@45")],
                             stall_timeout_s=120.0)
     result = explore_embodied(load_arena("arena1"), 2, config=config, seed=0)
-    assert not result.completed and result.ended_because == "stalled"
+    assert result.completed and result.ended_because == "completed reachable part"
+    assert result.map_correct and result.closed_vertices[0]["vertex"] == "v2"
+    assert sorted(tuple(e["edge"]) for e in result.unreachable_edges) == [("v1", "v2"),
+                                                                          ("v2", "v4")]
     assert result.collisions == 0
-    assert result.sim_time_s < 600.0
 
 
 def test_a_robot_dead_before_launch_never_launches():

@@ -170,6 +170,16 @@ class Strategy(ABC):
     ) -> Decision:
         """Handle an arrival (or a wake-up after idling) and decide what to do next."""
 
+    def block(self, angle: float) -> None:
+        """The edge at incidence ``angle`` (rad, the beacons' frame) from the vertex of
+        the latest call leads to a closed vertex (its station answered
+        :class:`~algorithms.exploration.entry.EntryBlocked`; issue 30): the robot did not
+        leave. The world then calls :meth:`on_vertex` again at that vertex with
+        ``arrived_by`` None, and that call writes the mark into the beacon and decides
+        anew. Only ``incidence-dfs`` routes round closed vertices
+        (:mod:`~algorithms.exploration.incidence_dfs`); every other strategy refuses here."""
+        raise NotImplementedError(f"strategy {self.name} cannot explore round a closed vertex")
+
     @abstractmethod
     def map_edges(self) -> list[tuple[str, str]]:
         """The robot's map: its known traversed edges as pairs of beacon ids."""

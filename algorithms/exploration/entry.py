@@ -49,6 +49,17 @@ and every message is counted with the radio's. The protocol, from the robot's si
    from ``w`` and not yet on ``u``'s centre). The robot passes and, off the opposite
    lane, sends :class:`PassDone`: the station opens the lane again. The pass is held
    like a vertex area: one robot per lane, so nothing comes towards it.
+7. Closed vertices (issue 30: a body that cannot be passed). A vertex whose area holds
+   a robot that stopped for good is *closed*: its station answers every request for it
+   with :class:`EntryBlocked` instead of a grant, at once for requests waiting in its
+   queue and for new ones when they come, naming the request's angle and never the
+   vertex (robots know no true ids). A robot granted the vertex before it closed, on its
+   way to it (waiting where its lane's wall ends for :class:`VertexClear`, since the
+   body's holder never cleared it), gets :class:`EntryBlocked` too, with the angle it
+   had asked for; it stops for good there, out of the vertex area and on a lane that
+   leads only into the closed vertex (see :mod:`algorithms.exploration.explorer`). A
+   robot on a centre that gets it marks the edge blocked
+   (:meth:`~algorithms.exploration.base.Strategy.block`) and decides anew.
 
 A station serves the beacon of its vertex only to the robot it granted (or launched
 there): a robot that arrives anywhere else finds no beacon and stops.
@@ -120,3 +131,12 @@ class PassGranted(NamedTuple):
 
 class PassDone(NamedTuple):
     """Robot → station: I am off the opposite lane; open it again."""
+
+
+class EntryBlocked(NamedTuple):
+    """Station → robot: the vertex along the edge at ``angle_rad`` (the request's angle)
+    is closed: a body that stopped for good stands in its area (step 7). The station
+    learns it from the switch-off in our runs; a real station would from the body's
+    silence in its area. The vertex is not named: robots know no true ids."""
+
+    angle_rad: float

@@ -46,8 +46,11 @@ Choices beyond the paper (the loop functions in :mod:`mjswarm.experiments.explor
   (:func:`~algorithms.navigation.navigator.frame_offset`), so odometry drift does not
   accumulate over revisits and every robot keeps the beacons' frame.
 * **Stopping for good**: lost its line, no beacon where it arrived, angles that match no
-  beacon, a strategy that cannot reconcile a beacon, an entry denied. It stands still,
-  says why (``halted``) and tells the stations.
+  beacon, a strategy that cannot reconcile a beacon, an entry denied, a vertex it was
+  granted that closed while it was on its way, a strategy that cannot route round a
+  closed vertex. It stands still, says why (``halted``) and tells the stations.
+* **Closed vertices**: an entry blocked on its centre (:class:`~algorithms.exploration.
+  entry.EntryBlocked`) is told to the strategy (``Strategy.block``) and decided anew.
 * **Idle**: a strategy that answers IDLE is asked again after ``idle_wait_s``.
 """
 
@@ -71,6 +74,7 @@ from algorithms.exploration.relay import ConnectedExplorer
 from algorithms.exploration.tether import Tether
 from algorithms.exploration.entry import (
     STATION,
+    EntryBlocked,
     EntryDenied,
     EntryGranted,
     EntryRequest,
@@ -227,7 +231,7 @@ class Explorer(Controller):
             out += self.table.tick(now, robots, observation.neighbors)
         for m in observation.inbox:
             if m.sender == STATION:
-                self._from_station(m.payload, out)
+                self._from_station(m.payload, out, observation)
         around = {}
         if self.tether is not None:
             around = {j: (d.range_m * math.cos(d.bearing_rad), d.range_m * math.sin(d.bearing_rad))
@@ -556,7 +560,7 @@ class Explorer(Controller):
         else:
             raise ValueError(f"the strategy answered an unknown decision {decision!r}")
 
-    def _from_station(self, payload: Any, out: list[Message]) -> None:
+    def _from_station(self, payload: Any, out: list[Message], observation: Observation) -> None:
         if isinstance(payload, EntryGranted):
             if payload.angle_rad is not None and (
                     self._asked is None or payload.angle_rad != self._asked.angle_rad):
@@ -584,6 +588,32 @@ class Explorer(Controller):
                 out.append(Message(PassDone(), STATION))
         elif isinstance(payload, EntryDenied):
             self._halt(payload.reason, out)
+        elif isinstance(payload, EntryBlocked):
+            self._blocked(payload, out, observation)
+
+    def _blocked(self, payload: EntryBlocked, out: list[Message],
+                 observation: Observation) -> None:
+        """The vertex it asked for is closed (:mod:`algorithms.exploration.entry`, step 7).
+        Waiting on its centre, it tells its strategy the edge is blocked and decides anew
+        there (the vertex call is re-run with the beacon it stands on, as a relay setting
+        out does); on its way (granted before the vertex closed), it stops for good where
+        the station told it, out of every vertex area, on a lane that leads only into the
+        closed vertex. An answer its withdrawal overtook is ignored."""
+        if self._departure is None:
+            if self._on_edge:
+                self._halt("the vertex it was granted closed (a body stopped in its area)", out)
+            return
+        if self._asked is None or payload.angle_rad != self._asked.angle_rad:
+            return
+        try:
+            self.strategy.block(payload.angle_rad)
+        except NotImplementedError as exc:
+            self._halt(str(exc), out)
+            return
+        self._departure, self._asked, self._withdrawn = None, None, False
+        if self.connected is not None:
+            self.connected.arrived_back()  # it never left: its leg is undone
+        self._vertex_call(observation.beacon, observation.time_s, False, out, back=True)
 
     def _depart(self) -> None:
         self.nav.depart(self._departure)

@@ -48,6 +48,20 @@ Choices where the paper is silent or ambiguous (each checked by tests):
   block fixed and moves the selected column to the front of the out block; the sparse
   matrix records it as one more selection of that out edge (``IncidenceMatrix.out``).
 * Completion is tested at every vertex visit, including vertices passed while travelling.
+* **Closed vertices** (ours, issue 30: a robot stopped for good in a vertex area that no
+  robot can pass). The station of a closed vertex answers a request for it with
+  ``EntryBlocked``; the robot has not left, and :meth:`IncidenceDFS.block` marks the end it
+  asked for blocked (:mod:`~algorithms.exploration.incidence_matrix`: a blocked end is
+  neither unexplored nor out, never a candidate, never left by on a route, and counts as
+  finished), drops its queue (the next call, at the same vertex, writes the mark into the
+  beacon and decides anew). An end of ``Em(Rk)`` outside the robot's reach (known vertices
+  reachable over ``Gc`` without leaving by a blocked end) is dropped as a taken one is, and
+  so is a decision whose queue holds a blocked end. Completion is Theorem 1's test on the
+  reach (the rule in :mod:`~algorithms.exploration.incidence_matrix`): the team declares
+  completion of the part it can reach, and a robot cut off from the root that has nothing
+  open within its reach answers IDLE. Without blocked ends every step takes the paper's
+  path unchanged. Only ``incidence-dfs`` handles closed vertices; the other strategies
+  refuse (:meth:`~algorithms.exploration.base.Strategy.block`).
 """
 
 from __future__ import annotations
@@ -55,7 +69,15 @@ from __future__ import annotations
 from abc import abstractmethod
 from collections.abc import Sequence
 
-from algorithms.exploration.base import DONE, Beacon, Decision, ccw_from
+from algorithms.exploration.base import (
+    DONE,
+    IDLE,
+    Beacon,
+    Decision,
+    ccw_from,
+    match_angle,
+    normalize_angle,
+)
 from algorithms.exploration.incidence_matrix import (
     COMPLETED,
     OUT,
@@ -86,13 +108,15 @@ class FrontierExplorer(MapStrategy):
     ) -> Decision:
         record, before = self.first_step(beacon, angles, arrived_by)
         self.observe()
-        if self.matrix.is_complete():
+        if self.matrix.is_complete(self.here, self.root):
             self.queue.clear()
             return DONE
         if self.queue and not self._keep(before):
             self.queue.clear()
         if not self.queue:
             selected = self.select()
+            if selected is None:  # cut off from the root, nothing open within reach
+                return IDLE
             self.matrix = self.matrix.select(selected, self.letters)
             self._selectors = self.matrix.selectors(selected)
             self.queue = [*self.matrix.route(self.here, selected[0]), selected]
@@ -101,8 +125,12 @@ class FrontierExplorer(MapStrategy):
 
     def _keep(self, before: IncidenceMatrix | None) -> bool:
         """Whether the decision in ``Q`` stands at this vertex (see module docstring)."""
-        selected = self.queue[-1]
-        if self.queue[0][0] != self.here or self.matrix.status(selected) == COMPLETED:
+        selected, m = self.queue[-1], self.matrix
+        if self.queue[0][0] != self.here or m.status(selected) == COMPLETED:
+            return False
+        # the matrix's blocked bit set, read directly: 0 but with closed vertices, and this
+        # runs at every vertex on the way (the graph world's hot path)
+        if m._blocked and any(map(m.is_blocked, self.queue)):
             return False
         if self.reselect == "completed" or before is None:
             return True
@@ -115,8 +143,9 @@ class FrontierExplorer(MapStrategy):
         """Hook run after the first step, before any decision."""
 
     @abstractmethod
-    def select(self) -> End:
-        """The edge to explore next; called only when the exploration is not complete."""
+    def select(self) -> End | None:
+        """The edge to explore next; called only when the exploration is not complete.
+        None: no open edge within the robot's reach (only with blocked ends)."""
 
     def pick(self, ends: list[End]) -> End:
         """One of equally near ends: the one fewest *other* robots are known to have
@@ -149,12 +178,29 @@ class IncidenceDFS(FrontierExplorer):
                 order = [order[i] for i in self.rng.permutation(len(order))]
             self.my_unexplored.extend((self.here, a) for a in reversed(order))
 
-    def select(self) -> End:
-        """Priority (4): the top of ``Em(Rk)`` that is still unexplored; else the nearest
-        unexplored edge (``Eu(Rk)``); else the nearest out edge (``Eo(Rk)``)."""
-        stack, status = self.my_unexplored, self.matrix.status
+    def select(self) -> End | None:
+        """Priority (4): the top of ``Em(Rk)`` that is still unexplored (and, with blocked
+        ends, not blocked and within reach); else the nearest unexplored edge
+        (``Eu(Rk)``); else the nearest out edge (``Eo(Rk)``); None if none is in reach."""
+        stack, m = self.my_unexplored, self.matrix
+        status = m.status
+        if m._blocked:  # as in ``_keep``
+            reach = m.reach(self.here)
+            while stack and (status(stack[-1]) != UNEXPLORED or m.is_blocked(stack[-1])
+                             or stack[-1][0] not in reach):
+                stack.pop()
         while stack and status(stack[-1]) != UNEXPLORED:
             stack.pop()
         if stack:
             return stack[-1]
-        return self.pick(self.matrix.nearest_open(self.here))
+        nearest = m.nearest_open(self.here)
+        return self.pick(nearest) if nearest else None
+
+    def block(self, angle: float) -> None:
+        """The edge at ``angle`` (rad, the beacons' frame) from the vertex of the latest
+        call leads to a closed vertex; the robot did not leave (module docstring)."""
+        here = self.here
+        self.matrix = self.matrix.block((here, match_angle(normalize_angle(angle),
+                                                           self.matrix.angles(here))))
+        self.queue.clear()
+        self.forget_departure()

@@ -29,11 +29,36 @@ matrix. A numbering is only a table of names, and only grows: what a matrix know
 its bits say. ``rows``, ``completed`` and ``out`` are built from the bits when asked for,
 in numbering order (the order in which the team first wrote each entry). Matrices of
 different numberings (built directly, e.g. by a test) are merged after renumbering one.
+
+Blocked ends (ours, issue 30: a body that cannot be passed). An end is *blocked* when
+the vertex at its far end is closed: a robot stopped for good in that vertex's area,
+and the station there answers every request for it with
+:class:`~algorithms.exploration.entry.EntryBlocked`. The robot that asked marks the end
+it asked for (:meth:`IncidenceMatrix.block`); blocked marks are one more bit set over the
+end positions, merged by union like the others (robots carry them beacon to beacon), and
+orthogonal to the status: an unexplored, out or completed end may be blocked (a
+completed edge into a vertex that closed later). A blocked end is never a candidate (not
+in ``Eu`` nor ``Eo`` for selection), and no route over ``Gc`` leaves by one. The *reach*
+of a vertex ``s`` is the set of known vertices reachable from ``s`` over ``Gc`` without
+leaving by a blocked end (:meth:`IncidenceMatrix.reach`).
+
+Theorem 1 with blocked ends (the rule). Exploration is complete for a robot at ``s`` iff
+its reach holds the root and every end of every vertex of its reach is completed or
+blocked. Without blocked ends the reach is every known vertex (Lemma 1: ``Gc`` is
+connected) and this is Theorem 1's test exactly. With them, the declared map is the
+completed graph of the reach: when vertices are closed from the start it is exactly the
+part of the graph reachable from the root without entering a closed vertex (every
+vertex of that part is found, by Theorem 1's argument applied to it, and every edge out
+of it ends blocked); a vertex that closed during the run may leave in the map edges
+completed before it closed (true edges, beyond that part). A robot cut off from the root
+(beyond a vertex that closed behind it) never declares: it finishes its reach and waits
+(its strategy answers IDLE). The bit set is 0 in every run without closed vertices, and
+every query then takes the old path.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from types import MappingProxyType
 
 import numpy as np
@@ -150,6 +175,8 @@ class IncidenceMatrix:
     chosen, is the one selected least. Sets of selectors keep that round-robin through
     merges (a union), where a plain count would lose selections made concurrently.
 
+    ``blocked``: the blocked ends (see the module docstring), ends of ``rows``.
+
     ``numbering`` (see :class:`Numbering`) is the one to write the matrix's entries in;
     None: a new one.
     """
@@ -161,8 +188,9 @@ class IncidenceMatrix:
     # of ``completed`` as a dict would order it, the end of a one-edge matrix that a merge
     # looks at (see :func:`merge`). ``_tree``: the source and the parents of the latest
     # breadth-first search over ``Gc`` (see :meth:`layers`), reused by :meth:`route`.
-    __slots__ = ("_completed", "_ends", "_first", "_moved", "_out", "_selections", "_tags",
-                 "_tree", "numbering")
+    # ``_blocked``: the blocked ends (module docstring), 0 without closed vertices.
+    __slots__ = ("_blocked", "_completed", "_ends", "_first", "_moved", "_out", "_selections",
+                 "_tags", "_tree", "numbering")
 
     def __init__(
         self,
@@ -170,6 +198,7 @@ class IncidenceMatrix:
         completed: dict[End, End],
         out: dict[End, frozenset[str]],
         numbering: Numbering | None = None,
+        blocked: Iterable[End] = (),
     ):
         n = _writable(numbering)
         tags = ends = 0
@@ -192,16 +221,20 @@ class IncidenceMatrix:
         self.numbering, self._tags, self._ends, self._completed = n, tags, ends, done
         self._out, self._selections = marked, selections
         self._moved, self._first = moved or _UNMOVED, next(iter(completed), None)
+        self._blocked = 0
+        for e in blocked:
+            self._blocked |= 1 << n.end(e)
         self._tree = None
 
     @classmethod
     def _of(cls, numbering: Numbering, tags: int, ends: int, completed: int, out: int,
-            selections: int, moved: Mapping[int, End], first: End | None) -> IncidenceMatrix:
+                selections: int, moved: Mapping[int, End], first: End | None,
+            blocked: int = 0) -> IncidenceMatrix:
         """A matrix from its bit sets (see the comment on ``__slots__``)."""
         m = object.__new__(cls)
         m.numbering, m._tags, m._ends, m._completed = numbering, tags, ends, completed
         m._out, m._selections, m._moved, m._first = out, selections, moved, first
-        m._tree = None
+        m._blocked, m._tree = blocked, None
         return m
 
     @classmethod
@@ -249,7 +282,22 @@ class IncidenceMatrix:
         """Out end -> letters of the robots known to have selected it (``Eo``)."""
         return {self.numbering.ends[i]: self._selectors(i) for i in _positions(self._out)}
 
+    @property
+    def any_blocked(self) -> bool:
+        """Whether some end is blocked (never, in a run without closed vertices)."""
+        return self._blocked != 0
+
+    @property
+    def blocked(self) -> list[End]:
+        """The blocked ends (module docstring), in numbering order."""
+        return [self.numbering.ends[i] for i in _positions(self._blocked)]
+
     # -- queries --------------------------------------------------------------------
+
+    def is_blocked(self, end: End) -> bool:
+        """Whether ``end`` leads to a closed vertex (module docstring)."""
+        i = self.numbering.end_index.get(end)
+        return i is not None and bool(self._blocked >> i & 1)
 
     def status(self, end: End) -> int:
         """``COMPLETED``, ``OUT``, ``UNEXPLORED`` or ``UNKNOWN`` (vertex not a row)."""
@@ -285,23 +333,45 @@ class IncidenceMatrix:
         """Number of non-zero entries the matrix would have if fully explored."""
         return self._ends.bit_count()
 
-    def is_complete(self) -> bool:
+    def is_complete(self, source: str | None = None, root: str | None = None) -> bool:
         """Theorem 1: exploration is complete iff ``Eu`` and ``Eo`` are empty, i.e. every
         end of every known vertex belongs to a completed edge (Remark 5: the rightmost
-        column of the ordered matrix is a completed one)."""
-        return self._completed.bit_count() == self._ends.bit_count()
+        column of the ordered matrix is a completed one).
+
+        With blocked ends, the rule of the module docstring for a robot at ``source``
+        (the tag it stands on) whose exploration started at ``root``: its reach holds
+        ``root`` and every end of its reach is completed or blocked (both needed then)."""
+        if not self._blocked:
+            return self._completed.bit_count() == self._ends.bit_count()
+        reach = self.reach(source)
+        if root not in reach:
+            return False
+        row_mask, ends = self.numbering.row_mask, 0
+        for t in reach:
+            ends |= row_mask[t]
+        return not ends & ~(self._completed | self._blocked)
+
+    def reach(self, source: str) -> set[str]:
+        """The tags reachable from ``source`` over ``Gc`` without leaving by a blocked end
+        (every known tag when none is blocked, Lemma 1)."""
+        return {t for layer in self.layers(source) for t in layer}
 
     def unexplored(self) -> list[End]:
-        """``Eu``: unexplored ends, in row order then angle order."""
+        """``Eu``: unexplored ends (blocked ones left out), in row order then angle order."""
         row_ends, taken = self.numbering.row_ends, self._completed | self._out
+        if self._blocked:
+            taken |= self._blocked
         return [(tag, a) for tag in self.rows for a, _, bit in row_ends[tag] if not taken & bit]
 
     def unexplored_at(self, tag: str) -> list[float]:
-        """Angles of the unexplored edges at vertex ``tag`` (``Em(vj)`` for a beacon)."""
+        """Angles of the unexplored edges at vertex ``tag`` (``Em(vj)`` for a beacon;
+        blocked ones left out)."""
         n = self.numbering
         if not self._tags & n.tag_bit.get(tag, 0):
             return []
         taken = self._completed | self._out
+        if self._blocked:
+            taken |= self._blocked
         return [a for a, _, bit in n.row_ends[tag] if not taken & bit]
 
     def completed_edges(self) -> list[tuple[End, End]]:
@@ -345,9 +415,12 @@ class IncidenceMatrix:
 
     def layers(self, source: str, parents: dict[str, End | None] | None = None):
         """Breadth-first layers of ``Gc`` from ``source``: lists of tags by hop distance,
-        each vertex's completed edges taken by angle. ``parents``, if given, receives for
-        each tag reached the end it was reached by (None for ``source``)."""
+        each vertex's completed edges taken by angle, never leaving by a blocked end.
+        ``parents``, if given, receives for each tag reached the end it was reached by
+        (None for ``source``)."""
         row_ends, done, other = self.numbering.row_ends, self._completed, self._others()
+        if self._blocked:
+            done &= ~self._blocked
         seen = {} if parents is None else parents
         seen[source] = None
         self._tree = (source, seen)  # the layers yielded so far are complete in it
@@ -378,8 +451,11 @@ class IncidenceMatrix:
 
     def nearest_open(self, source: str) -> list[End]:
         """The unexplored ends fewest hops from ``source`` over ``Gc``; if no end is
-        unexplored, the nearest out ends (empty when the exploration is complete)."""
+        unexplored, the nearest out ends (empty when the exploration is complete, or when
+        no open end is in the reach of ``source``). Blocked ends are never open."""
         n, done, out = self.numbering, self._completed, self._out
+        if self._blocked:
+            done |= self._blocked
         row_mask, row_ends = n.row_mask, n.row_ends
         nearest_out = 0
         for layer in self.layers(source):
@@ -437,13 +513,24 @@ class IncidenceMatrix:
         if self._selections & choice:
             return self
         m = self._of(n, self._tags, self._ends, self._completed, self._out | 1 << i,
-                     self._selections | choice, self._moved, self._first)
+                     self._selections | choice, self._moved, self._first, self._blocked)
         m._tree = self._tree  # the same Gc
         return m
 
+    def block(self, end: End) -> IncidenceMatrix:
+        """Mark ``end``, an end of a known row, blocked: the vertex at its far end is
+        closed (module docstring). Its status stays as it is."""
+        i = self.numbering.end_index.get(end)
+        if i is None or not self._ends >> i & 1:
+            raise KeyError(f"{end} is no end of a known vertex")
+        if self._blocked >> i & 1:
+            return self
+        return self._of(self.numbering, self._tags, self._ends, self._completed, self._out,
+                        self._selections, self._moved, self._first, self._blocked | 1 << i)
+
     def _renumbered(self, numbering: Numbering) -> IncidenceMatrix:
         """The same matrix written in ``numbering``."""
-        m = IncidenceMatrix(self.rows, self.completed, self.out, numbering)
+        m = IncidenceMatrix(self.rows, self.completed, self.out, numbering, self.blocked)
         m._first = self._first
         return m
 
@@ -483,7 +570,7 @@ def merge(a: IncidenceMatrix, b: IncidenceMatrix) -> IncidenceMatrix:
     count_a, count_b = a._completed.bit_count(), b._completed.bit_count()
     if count_a < count_b:
         a, b, count_b = b, a, count_a
-    if count_b == 2 and b._tags.bit_count() == 2 and not b._out:
+    if count_b == 2 and b._tags.bit_count() == 2 and not b._out and not b._blocked:
         if a._completed >> a.numbering.end_index[b._first] & 1 and not b._tags & ~a._tags:
             return a
         return _union(a, b)
@@ -511,13 +598,14 @@ def _union(a: IncidenceMatrix, b: IncidenceMatrix) -> IncidenceMatrix:
         moved.update(b._moved)
     return IncidenceMatrix._of(
         a.numbering, a._tags | b._tags, a._ends | b._ends, done, (a._out | b._out) & ~done,
-        selections, moved, a._first if a._completed else b._first)
+        selections, moved, a._first if a._completed else b._first, a._blocked | b._blocked)
 
 
 def _contains(a: IncidenceMatrix, b: IncidenceMatrix) -> bool:
     """True if every entry of ``b`` is in ``a`` with at least ``b``'s status (both of one
     numbering)."""
-    if b._tags & ~a._tags or b._completed & ~a._completed:
+    if b._tags & ~a._tags or b._completed & ~a._completed or (
+            b._blocked and b._blocked & ~a._blocked):
         return False
     missing = b._selections & ~a._selections
     if missing:  # selections of ends a knows as completed do not count

@@ -119,5 +119,17 @@ class MapStrategy(Strategy):
         self._left_by = end
         return go(end[1])
 
+    def forget_departure(self) -> None:
+        """It did not leave along the edge of its latest :meth:`leave` (the far vertex is
+        closed): its next call, at the same vertex, completes no edge."""
+        self._left_by = None
+
     def map_edges(self) -> list[tuple[str, str]]:
-        return [(e[0], f[0]) for e, f in self.matrix.completed_edges()]
+        """Its completed edges; with blocked ends, those within its reach (the part it
+        declares, :mod:`~algorithms.exploration.incidence_matrix`)."""
+        m = self.matrix
+        if m.any_blocked and self.here is not None:
+            reach = m.reach(self.here)
+            return [(e[0], f[0]) for e, f in m.completed_edges()
+                    if e[0] in reach and f[0] in reach]
+        return [(e[0], f[0]) for e, f in m.completed_edges()]

@@ -310,7 +310,17 @@ def summary(result: dict) -> str:
             f"{result['world']} world, root {result['root']}")
     traversals = f"traversals: {result['total_traversals']} in total " \
                  f"({per_robot(result['traversals_per_robot'])})"
-    if result["completed"]:
+    unreachable = result.get("unreachable_edges") or []
+    if result["completed"] and unreachable:  # closed vertices: the part it could reach
+        verdict = "covering" if result["map_correct"] else "NOT covering"
+        lines = [head,
+                 f"completed the reachable part: R{result['declared_by']} declared "
+                 f"completion at {result['declared_at']}; makespan {result['makespan']:g} "
+                 "edges (most by any robot)",
+                 traversals,
+                 f"map: {len(result['map_edges'])} edges, {verdict} the reachable part "
+                 f"({len(unreachable)} of the arena's edges unreachable)"]
+    elif result["completed"]:
         verdict = "equal to" if result["map_correct"] else "DIFFERENT from"
         unit = "edges (most by any robot)" if result["world"] == "embodied" else "steps"
         lines = [head,
@@ -353,6 +363,8 @@ def _embodied_lines(result: dict) -> list[str]:
     ]
     lines += [f"stopped: R{s['robot']} at {s['at_s']:.1f} s: {s['reason']}"
               for s in result["stopped_robots"]]
+    lines += [f"unreachable: {'-'.join(e['edge'])}: {e['why']}"
+              for e in result.get("unreachable_edges", [])]
     lines += [f"fault: {f['fault']} at {f['at_s']:.1f} s" if f["fired"] else
               f"fault: {f['fault']} not fired (the run ended at {end:.1f} s)"
               for f in result["faults"]]

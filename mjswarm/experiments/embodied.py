@@ -106,7 +106,8 @@ class EmbodiedResult(ExplorationResult):
     sim_time_s: float = 0.0
     wall_time_s: float = 0.0
     realtime_factor: float = 0.0
-    #: why the run ended: "completed", "stalled", "all robots stopped", "max time",
+    #: why the run ended: "completed", "completed reachable part" (closed vertices, see
+    #: ``unreachable_edges``), "stalled", "all robots stopped", "max time",
     #: "interrupted" (Ctrl-C; what was measured until then) or the infeasibility verdict
     ended_because: str = ""
     #: robots that stopped for good: ``{"robot": R, "reason": ..., "at_s": t}``
@@ -139,6 +140,16 @@ class EmbodiedResult(ExplorationResult):
     reason: str | None = None
     #: relay missions the robots set out on (rule 6 of :mod:`algorithms.exploration.relay`)
     relay_trips: int = 0
+    #: vertices closed by a body stopped for good in their area (issue 30, item 3):
+    #: ``{"vertex": v, "robot": R, "at_s": t}``, and every true edge outside the part
+    #: reachable from the root without entering one, and not in the declared map:
+    #: ``{"edge": [u, v], "why": text}`` (:func:`mjswarm.experiments.metrics.
+    #: reachable_part`). A declaration that leaves such edges is a completion of the
+    #: reachable part (``ended_because``: "completed reachable part"); with closed
+    #: vertices ``map_correct`` says the map holds every edge of that part and only true
+    #: edges (edges mapped before their vertex closed may be in it too).
+    closed_vertices: list[dict] = field(default_factory=list)
+    unreachable_edges: list[dict] = field(default_factory=list)
 
 
 def same_lane_bearing(range_m: float) -> float:

@@ -118,7 +118,7 @@ from mjswarm.experiments.embodied import (  # noqa: F401 - the experiment's publ
 )
 from mjswarm.experiments.faults import Faults
 from mjswarm.experiments.launching import Launching, depot
-from mjswarm.experiments.metrics import ExplorationMetrics, Roster
+from mjswarm.experiments.metrics import ExplorationMetrics, Roster, reachable_part
 from mjswarm.experiments.minds import make_minds, strategy_name
 from mjswarm.experiments.radio_exploration import NEED, infeasible_reason
 from mjswarm.experiments.results import outcome
@@ -300,6 +300,10 @@ class EmbodiedExploration(LoopFunctions):
                 f"{', 1 docked at the base' if world.docked else ''}, "
                 f"{len(self.metrics.stopped)} stopped")
 
+    def closed_items(self) -> list[tuple[str, tuple[int, float]]]:
+        """The closed vertices (:attr:`StationService.closed`), in the order they closed."""
+        return sorted(self.stations.closed.items(), key=lambda item: item[1][1])
+
     @property
     def declared(self) -> tuple[float, int, str] | None:
         """(time s, robot, vertex) of the completion declared, or None."""
@@ -317,11 +321,19 @@ class EmbodiedExploration(LoopFunctions):
         connected, biconnected = (None, None) if self.tether_truth is None else \
             self.tether_truth.shares()
         truth = self.tether_truth
+        true_edges = {tuple(sorted(e)) for e in self.spec.edges}
+        found = outcome(strategy_name(self.minds), m.declared, m.declared_map, m.makespan,
+                        m.paths, m.beacon_vertex, true_edges, arena=self.spec.name,
+                        root=self.spec.root, edge_time="physics", seed=self.seed)
+        closed, ended, unreachable = self.stations.closed, m.ended_because, []
+        if closed:  # issue 30: the part it could reach (EmbodiedResult's fields)
+            mapped = set(found["map_edges"])
+            reachable, unreachable = reachable_part(true_edges, self.spec.root, closed, mapped)
+            found["map_correct"] = m.declared is not None and reachable <= mapped <= true_edges
+            if ended == "completed" and unreachable:
+                ended = "completed reachable part"
         return EmbodiedResult(
-            **outcome(strategy_name(self.minds), m.declared, m.declared_map, m.makespan,
-                      m.paths, m.beacon_vertex, {tuple(sorted(e)) for e in self.spec.edges},
-                      arena=self.spec.name, root=self.spec.root, edge_time="physics",
-                      seed=self.seed),
+            **found,
             collisions=sim.collisions.count,
             speed_changes=m.speed_changes,
             sim_time_s=sim.time_s,
@@ -339,7 +351,10 @@ class EmbodiedExploration(LoopFunctions):
             infeasible=m.infeasible,
             relay_trips=m.relay_trips,
             reason=m.infeasible_reason(m.paths) if m.infeasible else None,
-            ended_because=m.ended_because,
+            ended_because=ended,
+            closed_vertices=[{"vertex": v, "robot": r + 1, "at_s": round(t, 2)}
+                             for v, (r, t) in self.closed_items()],
+            unreachable_edges=unreachable,
             stopped_robots=list(m.stopped),
             heading_error_deg=round(math.degrees(m.heading_error_rad), 3),
             faults=self.faults.log(),

@@ -8,8 +8,10 @@ Forms (times in simulated seconds; robots numbered from 1, as in every output):
     edge it had selected stays *out* in the beacons it marked; seed 003's priority (4)
     keeps out edges as the last candidates (``Eo``), so another robot takes it once the
     unexplored edges run out: a dead robot's claim never needs to expire for the
-    exploration to finish. If its body blocks a lane or a vertex that others need, the
-    run ends ``stalled`` and says so.
+    exploration to finish. A body left in a vertex area closes that vertex
+    (:mod:`mjswarm.experiments.stations`): the team completes the part it can still
+    reach and the result names the edges it could not (``unreachable_edges``). If its
+    body blocks a lane that others need, the run ends ``stalled`` and says so.
 ``beacon:V@T``
     The beacon at vertex V is wiped at T (its contents and id are gone). The next robot
     there drops a new beacon under a new id; robots that knew the old one keep both

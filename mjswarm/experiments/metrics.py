@@ -15,7 +15,9 @@ the time and true poses taken at the start of the tick.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Mapping
+
+import networkx as nx
 
 from algorithms.exploration.events import (
     Declared,
@@ -171,3 +173,43 @@ class ExplorationMetrics(LoopFunctions):
     def makespan(self) -> int | None:
         """The most edges any robot had traversed at completion (None: not completed)."""
         return None if self.declared is None else max(len(p) - 1 for p in self.paths)
+
+
+def reachable_part(edges: Iterable[tuple[str, str]], root: str,
+                   closed: Mapping[str, tuple[int, float]],
+                   mapped: Iterable[tuple[str, str]] = ()) -> tuple[set[tuple[str, str]],
+                                                                    list[dict]]:
+    """Ground truth of a run with closed vertices (issue 30; ``closed``: vertex -> (robot
+    index whose body closed it, time s), as the stations recorded them).
+
+    Returns the edges (sorted pairs) among the vertices reachable from ``root`` without
+    entering a closed vertex (the part a team can finish: empty if the root itself
+    closed), and every other edge the team could not reach, with why:
+    ``{"edge": [u, v], "why": text}``, the why naming the closed vertex it touches, or
+    the closed vertices it lies beyond. An edge of ``mapped`` (the declared map, sorted
+    pairs) was reached, before its vertex closed, and is not listed."""
+    mapped = set(mapped)
+    g = nx.Graph(list(edges))
+    open_part = g.subgraph(set(g) - set(closed))
+    part = set() if root in closed else nx.node_connected_component(open_part, root)
+
+    def closed_by(v: str) -> str:
+        robot, at_s = closed[v]
+        return f"{v} closed by R{robot + 1} stopped in its area at {at_s:.1f} s"
+
+    reachable, unreachable = set(), []
+    for u, v in sorted(tuple(sorted(e)) for e in g.edges):
+        if u in part and v in part:
+            reachable.add((u, v))
+            continue
+        if (u, v) in mapped:
+            continue
+        ends = [w for w in (u, v) if w in closed]
+        if ends:
+            why = "vertex " + " and ".join(closed_by(w) for w in ends)
+        else:
+            beyond = nx.node_connected_component(open_part, u)
+            gates = sorted({w for x in beyond for w in g[x] if w in closed})
+            why = "beyond vertex " + " and ".join(closed_by(w) for w in gates)
+        unreachable.append({"edge": [u, v], "why": why})
+    return reachable, unreachable

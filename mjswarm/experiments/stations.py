@@ -52,6 +52,22 @@ wait; the robot breaks it (:meth:`~algorithms.exploration.explorer.Explorer._cre
 robot held still on its lane for 5 s creeps on, guarded by its front IR, since vertex
 entry leaves nobody else on its lane).
 
+**Closed vertices** (issue 30, item 3: a body that cannot be passed). A robot that stops
+for good (a fault switches it off, or it halts) with its body in a vertex area keeps that
+vertex held for ever: the vertex is *closed* (:meth:`StationService._release`; the station
+learns it from the switch-off here, a real one would from a body in its area that has
+gone silent). Its station then answers every request for it with
+:class:`~algorithms.exploration.entry.EntryBlocked` instead of a grant: the requests in
+its queue at once, new ones when they come; the robot marks the edge blocked and decides
+anew. A robot granted the vertex before it closed (in a closed chain of waits, while the
+body was still leaving it) is on its way and waits, out of the area, for a
+:class:`~algorithms.exploration.entry.VertexClear` that will never come; the station
+answers it with ``EntryBlocked`` once it sees it clear of every vertex area, and it stops
+for good where it stands, on a lane that leads only into the closed vertex (so it blocks
+nobody; turning it back to the vertex it left is left to the walk-back machinery of
+rule 6). :attr:`StationService.closed` says which vertices closed, by whose body, and
+when (ground truth, for the result's unreachable edges).
+
 Grants go in the order of the requests (then robot index), so a waiting robot is served
 before later ones. Ground truth used here, as the paper's station had it: the arena's
 edges at each vertex (:func:`mjswarm.arena.geometry.vertex_fans`).
@@ -65,6 +81,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from algorithms.exploration.entry import (
+    EntryBlocked,
     EntryDenied,
     EntryGranted,
     EntryRequest,
@@ -236,6 +253,10 @@ class StationService(LoopFunctions):
         self.awaiting_clear: set[int] = set()
         #: robots that asked to pass a body and have not yet been told to
         self.pass_waiting: set[int] = set()
+        #: closed vertices (module docstring): vertex -> (robot whose body closed it, time s)
+        self.closed: dict[str, tuple[int, float]] = {}
+        #: robots on their way to a vertex that closed, to be told once out of every area
+        self.blocked_on_way: set[int] = set()
         self.loop: Loop | None = None
         world.beacon_at = self.beacon_at
         world.power_listeners.append(self._switched_off)
@@ -272,6 +293,10 @@ class StationService(LoopFunctions):
             self._receive(message.sender, message.payload)
         if not self.avoid:
             return
+        for j in sorted(self.blocked_on_way):  # out of every vertex area: told now
+            if self.nearest(j)[1] >= VERTEX_CLEAR_RADIUS_M:
+                self.blocked_on_way.discard(j)
+                self.uplink.reply(j, EntryBlocked(self.asked[j]))
         granted = self.stations.grant()
         for i, vertex in granted:  # a cycle's grants all take effect at once ...
             self.leaving[i], self.target[i] = self.target[i], vertex
@@ -342,6 +367,9 @@ class StationService(LoopFunctions):
             self.leaving[i], self.target[i] = vertex, None
             self.uplink.reply(i, EntryGranted(False, payload.angle_rad))
             return
+        if ahead in self.closed:  # it stays on its centre and decides anew
+            self.uplink.reply(i, EntryBlocked(payload.angle_rad))
+            return
         self.stations.request(i, vertex, ahead, self.world.time_s)
 
     def _withdraw(self, i: int) -> None:
@@ -380,15 +408,35 @@ class StationService(LoopFunctions):
     def _release(self, i: int) -> None:
         """Robot ``i`` stopped for good (or was switched off): its holds go; a station
         whose vertex area the body still occupies keeps the vertex closed (it sees the
-        body, as it sees who stands on its centre)."""
+        body, as it sees who stands on its centre) and blocks the robots that want it
+        (:meth:`_close`)."""
         self.stations.release_all(i)
+        self.blocked_on_way.discard(i)
         vertex, distance = self.nearest(i)
-        if distance < VERTEX_CLEAR_RADIUS_M:
-            self.stations.occupy(i, vertex)
         self.leaving[i] = None
         self.awaiting_clear.discard(i)
         self.pass_waiting.discard(i)
+        if distance < VERTEX_CLEAR_RADIUS_M:
+            self.stations.occupy(i, vertex)
+            self._close(vertex, i)
         self._tell_clear()
+
+    def _close(self, vertex: str, body: int) -> None:
+        """``vertex`` is closed by robot ``body``'s body (module docstring): the requests
+        for it waiting on centres are answered with ``EntryBlocked`` now; robots on their
+        way to it (granted, or walking back to it from a lane) once out of every area."""
+        self.closed.setdefault(vertex, (body, self.world.time_s))
+        for j, request in sorted(self.stations.requests.items()):
+            if request.to == vertex:
+                self.stations.withdraw(j)
+                if request.at is not None:
+                    self.uplink.reply(j, EntryBlocked(self.asked[j]))
+                else:
+                    self.blocked_on_way.add(j)
+        for j in range(len(self.target)):
+            if j != body and self.target[j] == vertex and self.world.present[j]:
+                self.awaiting_clear.discard(j)
+                self.blocked_on_way.add(j)
 
     def _tell_clear(self) -> None:
         """Tell the robots waiting for a vertex whose previous holder has now left it."""
