@@ -56,9 +56,10 @@ and every message is counted with the radio's. The protocol, from the robot's si
    vertex (robots know no true ids). A robot granted the vertex before it closed, on its
    way to it (waiting where its lane's wall ends for :class:`VertexClear`, since the
    body's holder never cleared it), gets :class:`EntryBlocked` too, with the angle it
-   had asked for; it stops for good there, out of the vertex area and on a lane that
-   leads only into the closed vertex (see :mod:`algorithms.exploration.explorer`). A
-   robot on a centre that gets it marks the edge blocked
+   had asked for; it marks the edge blocked and walks back to the vertex it left, as in
+   step 5 (a tethered robot stops for good there instead, out of the vertex area, on a
+   lane that leads only into the closed vertex). A robot on a centre that gets it marks
+   the edge blocked
    (:meth:`~algorithms.exploration.base.Strategy.block`) and decides anew.
 
 A station serves the beacon of its vertex only to the robot it granted (or launched

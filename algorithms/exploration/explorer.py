@@ -433,14 +433,20 @@ class Explorer(Controller):
             return 1
         sense = cx.direction(nav.odometry.distance_m - self._left_at_m)
         if sense < 0 and not self._turning:
-            if self.rule is None or nav.room_to_turn or nav.state is NavigatorState.ARRIVING:
-                self._turn_back(granted=self.rule is None)
-            elif not self._turn_asked:
-                self._turn_asked = True
-                out.append(Message(TurnedBack(from_lane=False), STATION))
+            self._walk_back(out)
             if not self._turning:
                 return 1
         return sense
+
+    def _walk_back(self, out: list[Message]) -> None:
+        """Turn back along its edge: at once on its lane (a U-turn) or without vertex
+        entry; nearer the vertex behind, once the station gives it that vertex back."""
+        nav = self.nav
+        if self.rule is None or nav.room_to_turn or nav.state is NavigatorState.ARRIVING:
+            self._turn_back(granted=self.rule is None)
+        elif not self._turn_asked:
+            self._turn_asked = True
+            out.append(Message(TurnedBack(from_lane=False), STATION))
 
     def _turn_back(self, granted: bool) -> None:
         """Start the walk back (``granted``: the vertex behind is its own already)."""
@@ -499,7 +505,7 @@ class Explorer(Controller):
                     self.rule.crossed_vertex()  # eq. (34)
                 back, self._turning, self._on_edge = self._turning, False, False
                 self._turn_asked = False
-                if back:
+                if back and self.connected is not None:
                     self.connected.arrived_back()
                 # the scan right after a launch is no arrival: the robot came by no edge;
                 # nor is a walk back (it traversed none)
@@ -524,7 +530,8 @@ class Explorer(Controller):
             self._halt("no beacon where it arrived (off the vertex centre, or not the "
                        "vertex it was granted)", out)
             return
-        arrived_by = nav.arrived_angle if arrived else None
+        # a walk back traversed no edge: only a tether's rules need to know it came back
+        arrived_by = nav.arrived_angle if arrived and (cx is not None or not back) else None
         try:
             if cx is None:
                 decision = self.strategy.on_vertex(beacon, nav.edge_angles, arrived_by)
@@ -596,12 +603,24 @@ class Explorer(Controller):
         """The vertex it asked for is closed (:mod:`algorithms.exploration.entry`, step 7).
         Waiting on its centre, it tells its strategy the edge is blocked and decides anew
         there (the vertex call is re-run with the beacon it stands on, as a relay setting
-        out does); on its way (granted before the vertex closed), it stops for good where
-        the station told it, out of every vertex area, on a lane that leads only into the
-        closed vertex. An answer its withdrawal overtook is ignored."""
+        out does). On its way (granted before the vertex closed; the station tells it once
+        it is out of every vertex area) it tells its strategy too, and walks back to the
+        vertex it left as rule 6's relays do (:meth:`_walk_back`; its arrival there is no
+        traversal, and it decides anew); a tethered robot, whose walks back belong to its
+        tether, stops for good there instead, on a lane that leads only into the closed
+        vertex. An answer its withdrawal overtook is ignored."""
         if self._departure is None:
-            if self._on_edge:
+            if not self._on_edge:
+                return
+            if self.connected is not None:
                 self._halt("the vertex it was granted closed (a body stopped in its area)", out)
+                return
+            try:
+                self.strategy.block(payload.angle_rad)
+            except NotImplementedError as exc:
+                self._halt(str(exc), out)
+                return
+            self._walk_back(out)
             return
         if self._asked is None or payload.angle_rad != self._asked.angle_rad:
             return

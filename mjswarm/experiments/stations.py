@@ -62,10 +62,10 @@ its queue at once, new ones when they come; the robot marks the edge blocked and
 anew. A robot granted the vertex before it closed (in a closed chain of waits, while the
 body was still leaving it) is on its way and waits, out of the area, for a
 :class:`~algorithms.exploration.entry.VertexClear` that will never come; the station
-answers it with ``EntryBlocked`` once it sees it clear of every vertex area, and it stops
-for good where it stands, on a lane that leads only into the closed vertex (so it blocks
-nobody; turning it back to the vertex it left is left to the walk-back machinery of
-rule 6). :attr:`StationService.closed` says which vertices closed, by whose body, and
+answers it with ``EntryBlocked`` once it sees it clear of every vertex area, and it walks
+back to the vertex it left, asking for it as rule 6's relays do (:class:`~algorithms.
+exploration.entry.TurnedBack`); a tethered robot stops for good where it stands, on a
+lane that leads only into the closed vertex (so it blocks nobody). :attr:`StationService.closed` says which vertices closed, by whose body, and
 when (ground truth, for the result's unreachable edges).
 
 Grants go in the order of the requests (then robot index), so a waiting robot is served
