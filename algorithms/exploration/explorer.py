@@ -609,25 +609,21 @@ class Explorer(Controller):
         traversal, and it decides anew); a tethered robot, whose walks back belong to its
         tether, stops for good there instead, on a lane that leads only into the closed
         vertex. An answer its withdrawal overtook is ignored."""
-        if self._departure is None:
-            if not self._on_edge:
-                return
-            if self.connected is not None:
-                self._halt("the vertex it was granted closed (a body stopped in its area)", out)
-                return
-            try:
-                self.strategy.block(payload.angle_rad)
-            except NotImplementedError as exc:
-                self._halt(str(exc), out)
-                return
-            self._walk_back(out)
+        on_way = self._departure is None
+        if on_way and not self._on_edge:
             return
-        if self._asked is None or payload.angle_rad != self._asked.angle_rad:
+        if on_way and self.connected is not None:
+            self._halt("the vertex it was granted closed (a body stopped in its area)", out)
+            return
+        if not on_way and (self._asked is None or payload.angle_rad != self._asked.angle_rad):
             return
         try:
             self.strategy.block(payload.angle_rad)
         except NotImplementedError as exc:
             self._halt(str(exc), out)
+            return
+        if on_way:
+            self._walk_back(out)
             return
         self._departure, self._asked, self._withdrawn = None, None, False
         if self.connected is not None:
