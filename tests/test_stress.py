@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import pytest
 
+from mjswarm.experiments.faults import parse_fault
 from mjswarm.experiments.stress import (
     MAX_HEADING_ERROR_DEG,
     NOISE_ARENAS,
@@ -14,6 +15,9 @@ from mjswarm.experiments.stress import (
     SAMPLE_TEAMS,
     Noise,
     StressRun,
+    DEAD_SPEEDS_M_S,
+    PHYSICS,
+    dead_grid,
     dense_grid,
     grid,
     main,
@@ -82,13 +86,37 @@ def test_the_dense_grid_gives_one_robot_for_every_7_5_and_4_edges():
 
 @pytest.mark.parametrize("argv,message", [
     (["--sample"], "--sample needs --noise or --dense"),
-    (["--dense", "--noise"], "choose one of --noise and --dense"),
+    (["--dense", "--noise"], "choose one of --noise, --dense and --dead"),
+    (["--dead", "--dense"], "choose one of --noise, --dense and --dead"),
     (["--dense", "--only-slip"], "--slip and --only-slip need --noise"),
 ])
 def test_stress_flags_that_do_not_go_together_are_refused(capsys, argv, message):
     with pytest.raises(SystemExit) as stop:
         main(argv)
     assert stop.value.code == 2 and message in capsys.readouterr().err
+
+
+def test_the_dead_grid_spreads_faults_over_robots_times_speeds_and_tiers():
+    runs = dead_grid(arenas=("tree3", "lattice:4x4"))
+    faults = [parse_fault(r.fault) for r in runs]
+    assert all(0 <= f.robot < r.robots for f, r in zip(faults, runs))
+    assert {r.robots for r in runs} == {2, 4, 8}
+    assert {r.physics for r in runs} == set(PHYSICS)
+    assert {r.speed_m_s for r in runs} == set(DEAD_SPEEDS_M_S)
+    times = [f.at_s for f in faults]
+    assert min(times) == 0.0 and max(times) > 100.0 and len(set(times)) > len(times) // 3
+
+
+@pytest.mark.slow
+def test_the_dead_robot_grid_passes_but_where_the_body_closes_the_root():
+    """Issue 30's dead-robot grid: every run completes the true map or the reachable part,
+    no contact, nobody stopped but the failed robot; except (not solved, README) runs in
+    which the failed robot's body closes the root itself."""
+    rows = run_grid(dead_grid(), workers=2)
+    failures = [(r, res.ended_because, res.collisions, res.stopped_robots)
+                for r, res, _ in rows if not passed(res) and not any(
+                    c["vertex"] == r.spec().root for c in res.closed_vertices)]
+    assert failures == []
 
 
 @pytest.mark.slow

@@ -19,8 +19,7 @@ every run must pass as the stress grid's do.
 
 The dead-robot grid (issue 30, ``--dead``): one robot fails (``--fault robot:I@T``) on
 trees, the paper's arenas, a lattice and a random planar graph, teams of 2, 4 and 8,
-fault times from before the launch to half-way through a robot's share of the work,
-speeds 0.05-0.2 m/s in turn, both physics tiers. A run passes when it ends completed
+fault times from before the launch to a whole robot's share of the work, speeds 0.05-0.2 m/s in turn, both physics tiers. A run passes when it ends completed
 with the true map or with everything still reachable mapped and the rest named, no
 robot but the failed one stopped, and no contact.
 """
@@ -118,7 +117,7 @@ DENSE_SAMPLE = {"edges_per_robot": (5, 4), "speeds": (0.2,), "seeds": (0,)}
 DEAD_ARENAS = ("tree3", "tree4", "arena1", "arena2", "lattice:4x4", "random-planar:12:2")
 DEAD_TEAMS = (2, 4, 8)
 DEAD_SPEEDS_M_S = (0.05, 0.1, 0.15, 0.2)
-DEAD_FRACTIONS = (0.0, 0.15, 0.4)
+DEAD_FRACTIONS = (0.0, 0.3, 1.0)
 
 
 @dataclass(frozen=True)
