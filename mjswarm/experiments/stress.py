@@ -19,9 +19,10 @@ every run must pass as the stress grid's do.
 
 The dead-robot grid (issue 30, ``--dead``): one robot fails (``--fault robot:I@T``) on
 trees, the paper's arenas, a lattice and a random planar graph, teams of 2, 4 and 8,
-fault times from before the launch to a whole robot's share of the work, speeds 0.05-0.2 m/s in turn, both physics tiers. A run passes when it ends completed
-with the true map or with everything still reachable mapped and the rest named, no
-robot but the failed one stopped, and no contact.
+fault times from before the launch to a whole robot's share of the work, speeds
+0.05-0.2 m/s in turn, both physics tiers. A run passes when it ends completed with the
+true map or with everything still reachable mapped and the rest named, no robot but the
+failed one stopped, and no contact.
 """
 
 from __future__ import annotations
