@@ -10,8 +10,9 @@ Forms (times in simulated seconds; robots numbered from 1, as in every output):
     unexplored edges run out: a dead robot's claim never needs to expire for the
     exploration to finish. A body left in a vertex area closes that vertex
     (:mod:`mjswarm.experiments.stations`): the team completes the part it can still
-    reach and the result names the edges it could not (``unreachable_edges``). If its
-    body blocks a lane that others need, the run ends ``stalled`` and says so.
+    reach and the result names the edges it could not (``unreachable_edges``). A body on
+    a lane is passed on the opposite lane (:mod:`algorithms.exploration.entry`, step 6).
+    A body that closes the root ends the run ``stalled`` (README, "Dead robots").
 ``beacon:V@T``
     The beacon at vertex V is wiped at T (its contents and id are gone). The next robot
     there drops a new beacon under a new id; robots that knew the old one keep both
