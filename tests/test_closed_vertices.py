@@ -41,11 +41,16 @@ def reachable_edges(g: nx.Graph, root: str, closed: set[str]) -> set[frozenset]:
 
 def explore_closed(spec_name: str, k: int, closed: set[str] = frozenset(),
                    deaths: dict[int, int] | None = None, seed: int | None = None,
-                   strategy: str = "incidence-dfs", max_time: int = 2000):
+                   strategy: str = "incidence-dfs", max_time: int = 2000,
+                   root_death: int | None = None):
     """Run ``k`` minds on ``spec_name`` with ``closed`` vertices closed from the start and
     ``deaths`` {time: robot}: that robot stops for good on the vertex it arrives at then
-    (if it arrives then, not at the root, and no robot stands idle there), closing it. Returns (declared (robot, vertex, map) or None,
-    closed vertices, live robots' vertices, the graph, the root)."""
+    (if it arrives then, not at the root, and no robot stands idle there), closing it;
+    ``root_death``: that robot stops for good on the root at the start, at its turn,
+    closing the root (the robots after it never leave: they are the depot's). A robot
+    that answers CUT_OFF stands for good. Returns (declared (robot, vertex, map)
+    or None, closed vertices, live robots' vertices, the graph, the root, the robots cut
+    off {robot: (vertex, map)})."""
     spec = load_arena(spec_name)
     world = GraphWorld(spec.graph(), spec.root)  # the true angles at every vertex
     g, root = spec.graph(), spec.root
@@ -54,14 +59,23 @@ def explore_closed(spec_name: str, k: int, closed: set[str] = frozenset(),
     beacons = {v: Beacon() for v in g}
     at, due, by = [root] * k, [0] * k, [None] * k
     left: list[tuple[str, float] | None] = [None] * k  # on its way: (from, angle)
-    alive = set(range(k))
+    alive, cut = set(range(k)), {}
+
+    def mapped(i):
+        ids = {b.id: u for u, b in beacons.items() if b.id is not None}
+        return {frozenset((ids[a], ids[b])) for a, b in minds[i].map_edges()}
+
     for t in range(max_time):
         dying = deaths.pop(t, None)
         if dying in alive and due[dying] == t and at[dying] != root and not any(
                 at[j] == at[dying] and by[j] is None for j in alive - {dying}):
             alive.discard(dying)  # it dies as it arrives, on the vertex centre; others
             closed.add(at[dying])  # arriving there now were on their way: they turn back
-        for i in sorted((i for i in alive if due[i] == t), reverse=True):
+        for i in sorted((i for i in alive - cut.keys() if due[i] == t), reverse=True):
+            if t == 0 and root_death is not None and i <= root_death:
+                alive -= set(range(root_death + 1))  # it dies, the rest never leave
+                closed.add(root)
+                break
             if at[i] in closed:  # it was on its way when the vertex closed: back
                 (at[i], angle), by[i] = left[i], None
                 minds[i].block(angle)
@@ -72,18 +86,19 @@ def explore_closed(spec_name: str, k: int, closed: set[str] = frozenset(),
                 minds[i].block(decision.angle)  # the station's EntryBlocked
                 decision = minds[i].on_vertex(beacons[v], world.angles[v], None)
             if decision.action == "done":
-                ids = {b.id: u for u, b in beacons.items() if b.id is not None}
-                mapped = {frozenset((ids[a], ids[b])) for a, b in minds[i].map_edges()}
-                return (i, v, mapped), closed, {at[j] for j in alive}, g, root
+                return (i, v, mapped(i)), closed, {at[j] for j in alive}, g, root, cut
+            if decision.action == "cut off":
+                cut[i] = (v, mapped(i))
+                continue
             if decision.action == "go":
                 w = world.towards[(v, decision.angle)]
                 left[i], at[i], by[i] = (v, decision.angle), w, world.angle_of[(w, v)]
             else:
                 by[i] = None
             due[i] = t + 1
-        if not any(due[i] > t for i in alive):
+        if not any(due[i] > t for i in alive - cut.keys()):
             break
-    return None, closed, {at[j] for j in alive}, g, root
+    return None, closed, {at[j] for j in alive}, g, root, cut
 
 
 GRAPHS = [f"random-graph:{v}:{e}:{s}" for v, e, s in
@@ -104,7 +119,7 @@ def test_closed_from_the_start_the_map_is_exactly_the_reachable_part(arena):
         closed = set(rng.choice(others, size=int(rng.integers(1, 4)), replace=False))
         k = int(rng.integers(1, 6))
         seed = None if trial % 2 else int(rng.integers(1000))
-        declared, _, _, g, root = explore_closed(arena, k, closed, seed=seed)
+        declared, _, _, g, root, _ = explore_closed(arena, k, closed, seed=seed)
         assert declared is not None, (arena, closed, k)
         assert declared[2] == reachable_edges(g, root, closed), (arena, closed, k, seed)
 
@@ -124,7 +139,8 @@ def test_a_robot_dying_mid_run_leaves_an_honest_declaration(arena):
         deaths = {int(rng.integers(1, len(true))): int(rng.integers(k))
                   for _ in range(int(rng.integers(1, 3)))}
         seed = None if trial % 2 else int(rng.integers(1000))
-        declared, closed, standing, g, root = explore_closed(arena, k, deaths=deaths, seed=seed)
+        declared, closed, standing, g, root, _ = explore_closed(arena, k, deaths=deaths,
+                                                                seed=seed)
         reach = reachable_edges(g, root, closed) if root not in closed else set()
         if declared is None:
             part = nx.node_connected_component(g.subgraph(set(g) - closed), root)
@@ -136,10 +152,45 @@ def test_a_robot_dying_mid_run_leaves_an_honest_declaration(arena):
     assert declarations >= 8 and cut >= 3
 
 
+@pytest.mark.parametrize("arena", GRAPHS)
+def test_a_closed_root_leaves_every_robot_out_to_finish_its_part(arena):
+    """A robot stops for good on the root as the team sets out (and, in two trials of
+    three, another stops mid-run). Unless a robot's reach still holds the root (every
+    end of the root was finished as the team set out; nobody asked for it since) and it
+    declares, every live robot out ends CUT_OFF with a map that covers its component of
+    the graph without the closed vertices (networkx); a declared map covers every such
+    component next to the root. Only true edges in any map."""
+    rng = np.random.default_rng(zlib.crc32(arena.encode()) + 2)
+    spec = load_arena(arena)
+    true = {frozenset(e) for e in spec.graph().edges}
+    for trial in range(10):
+        k = int(rng.integers(2, 7))
+        root_death = int(rng.integers(k - 1))  # robots root_death + 1 .. k - 1 are out
+        deaths = {int(rng.integers(1, len(true))): int(rng.integers(root_death + 1, k))
+                  } if trial % 3 else {}
+        seed = None if trial % 2 else int(rng.integers(1000))
+        declared, closed, standing, g, root, cut = explore_closed(
+            arena, k, deaths=deaths, seed=seed, root_death=root_death)
+        assert root in closed
+        open_part = g.subgraph(set(g) - closed)
+        if declared is not None:  # every end of its reach, the root's too, was finished:
+            # the map covers the components next to the root (none closed from it)
+            maps = [(v, declared[2]) for v in set(g[root]) - closed]
+        else:
+            maps = list(cut.values())
+            assert {v for v, _ in maps} == standing, (arena, root_death, k, seed)
+        for v, mapped in maps:
+            component = nx.node_connected_component(open_part, v)
+            around = {frozenset(e) for e in g.edges(component)}  # every edge it touches
+            assert {frozenset(e) for e in open_part.subgraph(component).edges} <= mapped
+            assert mapped <= true and around - mapped <= {
+                e for e in around if e & closed}, (arena, root_death, k, seed)
+
+
 def test_without_closed_vertices_nothing_changes():
     """The harness without closures explores the whole graph, as the graph world does."""
     for arena in GRAPHS:
-        declared, *_ , g, root = explore_closed(arena, 3)
+        declared, *_, g, root, _ = explore_closed(arena, 3)
         assert declared[2] == {frozenset(e) for e in g.edges}
 
 
@@ -245,3 +296,56 @@ def test_embodied_robot_dying_on_a_vertex_centre_leaves_the_reachable_part_compl
     text = summary(d)
     assert "completed the reachable part: R" in text
     assert "unreachable: v3-v6: vertex v6 closed by R2 stopped in its area at 150.0 s" in text
+
+
+def test_embodied_root_closed_before_anyone_left_ends_with_nothing_reachable():
+    """arena2, 2 robots at 0.05 m/s: R1 is switched off at 16 s on the root, before it
+    has left; R2 can never be launched. Nothing can be reached from a closed root: the
+    team's completion (the experiment's rule for a closed root) with an empty map, every
+    edge named unreachable beyond the root, nobody declaring and nobody stopped but R1."""
+    from mjswarm.cli.explore import summary
+    from mjswarm.experiments.embodied import EmbodiedConfig
+    from mjswarm.experiments.exploration import explore_embodied
+    from mjswarm.experiments.faults import parse_fault
+
+    spec = load_arena("arena2")
+    result = explore_embodied(spec, 2, config=EmbodiedConfig(
+        speed_m_s=0.05, faults=[parse_fault("robot:1@16")]))
+    assert result.ended_because == "completed reachable part"
+    assert result.completed and result.map_correct and result.declared_by is None
+    assert result.map_edges == [] and result.total_traversals == 0
+    assert result.closed_vertices == [{"vertex": "v1", "robot": 1, "at_s": 16.0}]
+    assert len(result.unreachable_edges) == len(spec.edges)
+    assert all("v1 closed by R1" in e["why"] for e in result.unreachable_edges)
+    assert [s["robot"] for s in result.stopped_robots] == [1]
+    d = result.to_dict()
+    d["world"], d["recording"], d["video"] = "embodied", None, None
+    assert "completed the reachable part: no robot was out when the root closed" in summary(d)
+
+
+def test_embodied_robot_cut_off_by_a_closed_root_finishes_its_part():
+    """tree3, 2 robots at 0.2 m/s (kinematic tier): R1 and R2 swap v1 (the root) and v3;
+    R1 is switched off at 320 s turning on the root's centre, closing it, while R2 is in
+    v3's corridor on its way to the root. The station gives R2 v3 back (its swap partner
+    stopped for good), R2 walks back, finds every end of its reach finished and says it is
+    cut off; the team's completion is its map, which covers its component of the arena
+    without the root, and the result names the rest."""
+    import networkx as nx
+
+    from mjswarm.experiments.embodied import EmbodiedConfig
+    from mjswarm.experiments.exploration import explore_embodied
+    from mjswarm.experiments.faults import parse_fault
+
+    spec = load_arena("tree3")
+    result = explore_embodied(spec, 2, config=EmbodiedConfig(
+        speed_m_s=0.2, physics="kinematic", faults=[parse_fault("robot:1@320")]))
+    assert result.ended_because == "completed reachable part"
+    assert result.closed_vertices[0]["vertex"] == spec.root and result.collisions == 0
+    assert result.declared_by == 2 and result.map_correct
+    assert [s["robot"] for s in result.stopped_robots] == [1]
+    g = spec.graph()
+    part = nx.node_connected_component(g.subgraph(set(g) - {spec.root}), result.declared_at)
+    inside = {tuple(sorted(e)) for e in g.subgraph(part).edges}
+    assert inside and inside <= set(result.map_edges)
+    named = {tuple(e["edge"]) for e in result.unreachable_edges}
+    assert named == {tuple(sorted(e)) for e in g.edges} - set(result.map_edges)

@@ -17,8 +17,8 @@ calls :meth:`Strategy.on_vertex` with
   ``None`` when it did not move since its previous call (the start, or after idling).
 
 It answers with a :class:`Decision`: leave along the edge at ``angle``, ``DONE``
-(completion declared) or ``IDLE`` (nothing to do now; the world calls again one time unit
-later with ``arrived_by=None``).
+(completion declared), ``IDLE`` (nothing to do now; the world calls again one time unit
+later with ``arrived_by=None``) or, only where vertices close (issue 30), ``CUT_OFF``.
 
 Robots that arrive at one vertex at the same time are handled one after another, each
 seeing the beacon as the previous one left it, in *descending* robot index. Seed 003's
@@ -50,7 +50,8 @@ class AngleMismatch(ValueError):
 
 @dataclass(frozen=True, slots=True)
 class Decision:
-    """What a robot does after a vertex visit: ``go`` along ``angle``, ``done`` or ``idle``."""
+    """What a robot does after a vertex visit: ``go`` along ``angle``, ``done``, ``idle``
+    or ``cut off``."""
 
     action: str
     angle: float | None = None
@@ -58,6 +59,10 @@ class Decision:
 
 DONE = Decision("done")
 IDLE = Decision("idle")
+#: Cut off from the root by closed vertices (issue 30), with every end of its reach
+#: completed or blocked: the robot finished the part of the graph it can still reach and
+#: stops for good (it declares nothing: see ``incidence_matrix``'s rule).
+CUT_OFF = Decision("cut off")
 
 
 def go(angle: float) -> Decision:

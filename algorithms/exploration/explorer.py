@@ -188,8 +188,9 @@ class Explorer(Controller):
         self.calls: list[VertexCall] = []
         #: why it stopped for good, or None
         self.halted: str | None = None
-        #: whether its strategy declared the exploration complete
-        self.declared = False
+        #: whether its strategy finished: declared the exploration complete, or finished
+        #: the part it can reach, cut off from the root (``CUT_OFF``, issue 30)
+        self.finished = False
         #: its speed in the last tick (m/s): the rule's on a lane, else S
         self.speed_m_s = speed_m_s
         self._handled = 0
@@ -237,7 +238,7 @@ class Explorer(Controller):
             around = {j: (d.range_m * math.cos(d.bearing_rad), d.range_m * math.sin(d.bearing_rad))
                       for j, d in observation.detections.items()}
             self._hear(now, observation, around, out)
-        if self.halted is not None or self.declared or self.infeasible:
+        if self.halted is not None or self.finished or self.infeasible:
             if self.connected is not None:
                 self.connected.retire()  # it serves as nobody's relay
             return self._stand(now, out, around)
@@ -331,7 +332,7 @@ class Explorer(Controller):
         v, w = nav.update(percept(observation.line_m, observation.ir_m,
                                   observation.encoder_rad, nav.line_filter))
         self._on_events(observation, out)
-        if self.halted is not None or self.declared:
+        if self.halted is not None or self.finished:
             return Command(messages=tuple(out))
         if sense == 0:  # rule 6: a relay, or waiting to: it stands on its edge
             v = w = 0.0
@@ -562,8 +563,10 @@ class Explorer(Controller):
         elif decision.action == "idle":
             self._idle_since = now_s
         elif decision.action == "done":
-            self.declared = True
+            self.finished = True
             self._events.append(Declared(mapped))
+        elif decision.action == "cut off":  # it stands for good; VertexCalled tells
+            self.finished = True
         else:
             raise ValueError(f"the strategy answered an unknown decision {decision!r}")
 

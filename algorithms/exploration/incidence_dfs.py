@@ -58,8 +58,9 @@ Choices where the paper is silent or ambiguous (each checked by tests):
   reachable over ``Gc`` without leaving by a blocked end) is dropped as a taken one is, and
   so is a decision whose queue holds a blocked end. Completion is Theorem 1's test on the
   reach (the rule in :mod:`~algorithms.exploration.incidence_matrix`): the team declares
-  completion of the part it can reach, and a robot cut off from the root that has nothing
-  open within its reach answers IDLE. Without blocked ends every step takes the paper's
+  completion of the part it can reach; a robot cut off from the root answers IDLE while
+  its reach holds an end out (another robot on it), and ``CUT_OFF`` once its whole reach
+  is finished. Without blocked ends every step takes the paper's
   path unchanged. Only ``incidence-dfs`` handles closed vertices; the other strategies
   refuse (:meth:`~algorithms.exploration.base.Strategy.block`).
 """
@@ -70,6 +71,7 @@ from abc import abstractmethod
 from collections.abc import Sequence
 
 from algorithms.exploration.base import (
+    CUT_OFF,
     DONE,
     IDLE,
     Beacon,
@@ -116,7 +118,7 @@ class FrontierExplorer(MapStrategy):
         if not self.queue:
             selected = self.select()
             if selected is None:  # cut off from the root, nothing open within reach
-                return IDLE
+                return CUT_OFF if self.matrix.reach_finished(self.here) else IDLE
             self.matrix = self.matrix.select(selected, self.letters)
             self._selectors = self.matrix.selectors(selected)
             self.queue = [*self.matrix.route(self.here, selected[0]), selected]

@@ -51,9 +51,14 @@ part of the graph reachable from the root without entering a closed vertex (ever
 vertex of that part is found, by Theorem 1's argument applied to it, and every edge out
 of it ends blocked); a vertex that closed during the run may leave in the map edges
 completed before it closed (true edges, beyond that part). A robot cut off from the root
-(beyond a vertex that closed behind it) never declares: it finishes its reach and waits
-(its strategy answers IDLE). The bit set is 0 in every run without closed vertices, and
-every query then takes the old path.
+(beyond a vertex that closed behind it, or the root itself closed) never declares: when
+every end of its reach is completed or blocked (:meth:`IncidenceMatrix.reach_finished`)
+its reach is the whole of its component of the graph without the closed vertices (no
+end of it leads anywhere else), which no robot can enter or leave any more; it has
+finished that part and stops (``CUT_OFF``). Only the team can tell that nothing is left
+(no robot knows whether others, cut off elsewhere, still work): the experiment's rule
+for a closed root is in ``mjswarm.experiments.exploration``. The bit set is 0 in every
+run without closed vertices, and every query then takes the old path.
 """
 
 from __future__ import annotations
@@ -344,8 +349,15 @@ class IncidenceMatrix:
         if not self._blocked:
             return self._completed.bit_count() == self._ends.bit_count()
         reach = self.reach(source)
-        if root not in reach:
-            return False
+        return root in reach and self._finished(reach)
+
+    def reach_finished(self, source: str) -> bool:
+        """Whether every end of the reach of ``source`` is completed or blocked (the reach
+        is then ``source``'s whole component without the closed vertices; module
+        docstring)."""
+        return self._finished(self.reach(source))
+
+    def _finished(self, reach: set[str]) -> bool:
         row_mask, ends = self.numbering.row_mask, 0
         for t in reach:
             ends |= row_mask[t]

@@ -313,9 +313,10 @@ def summary(result: dict) -> str:
     unreachable = result.get("unreachable_edges") or []
     if result["completed"] and unreachable:  # closed vertices: the part it could reach
         verdict = "covering" if result["map_correct"] else "NOT covering"
+        by = "no robot was out when the root closed" if result["declared_by"] is None else \
+            f"R{result['declared_by']} declared completion at {result['declared_at']}"
         lines = [head,
-                 f"completed the reachable part: R{result['declared_by']} declared "
-                 f"completion at {result['declared_at']}; makespan {result['makespan']:g} "
+                 f"completed the reachable part: {by}; makespan {result['makespan']:g} "
                  "edges (most by any robot)",
                  traversals,
                  f"map: {len(result['map_edges'])} edges, {verdict} the reachable part "

@@ -279,11 +279,12 @@ class EmbodiedExploration(LoopFunctions):
     def _end(self, bar: tqdm, log: bool) -> EmbodiedResult:
         """Close the progress display, mark the end of the run, and the result."""
         bar.close()
-        self.loop.event(f"run ended: {self.metrics.ended_because}")
         wall = time.perf_counter() - self._start
+        result = self.result(wall=wall)
+        self.loop.event(f"run ended: {result.ended_because}")
         if log:
             print(self._status(wall), file=sys.stderr, flush=True)
-        return self.result(wall=wall)
+        return result
 
     def step(self) -> None:
         """One control tick of the loop (for tests and scripts that drive it by hand)."""
@@ -315,6 +316,38 @@ class EmbodiedExploration(LoopFunctions):
                       if b.id is not None], BEACON_LABEL)
 
     # ------------------------------------------------------------------ result
+    def _team_finished_without_root(self, ended: str) -> dict | None:
+        """The team's completion when the root closed (issue 30), or None. No robot can
+        declare then (its reach never holds the root: ``incidence_matrix``'s rule), so
+        the verdict is the experimenter's, as "all robots stopped" is: every robot
+        failed, cannot be launched, or is cut off and finished the part it can reach
+        (``CUT_OFF``: that part is its whole component of the graph without the closed
+        vertices), and one robot at least did not fail (a team whose robots all failed
+        finished nothing). Returns the cut-off robots (:attr:`Roster.cut_off`)."""
+        r = self.roster
+        if ended != "all robots stopped" or self.spec.root not in self.stations.closed:
+            return None
+        team = [i for i in range(self.world.n) if i not in r.docked]
+        if any(i not in r.failed and i not in r.unlaunched and i not in r.cut_off
+               for i in team) or all(i in r.failed for i in team):
+            return None  # a robot stopped for another reason, or nobody is left
+        return r.cut_off
+
+    def _cut_off_outcome(self, cut_off: dict, true_edges: set) -> dict:
+        """:func:`outcome` for a team finished without its root: the map is the union of
+        the cut-off robots' maps, declared by the last of them to finish (by nobody if
+        none was out when the root closed)."""
+        m = self.metrics
+        last = max(cut_off, key=lambda i: cut_off[i][0], default=None)
+        declared = None if last is None else (cut_off[last][0], last, cut_off[last][1])
+        union = sorted({e for _, _, edges in cut_off.values() for e in edges})
+        found = outcome(strategy_name(self.minds), declared, union,
+                        max(len(p) - 1 for p in m.paths), m.paths, m.beacon_vertex,
+                        true_edges, arena=self.spec.name, root=self.spec.root,
+                        edge_time="physics", seed=self.seed)
+        found["completed"] = True
+        return found
+
     def result(self, loop: Loop | None = None, wall: float = 0.0) -> EmbodiedResult:
         """The measurements so far (``wall``: wall-clock seconds spent, for the rates)."""
         m, sim, radio = self.metrics, self.sim, self.world.radio
@@ -327,9 +360,14 @@ class EmbodiedExploration(LoopFunctions):
                         root=self.spec.root, edge_time="physics", seed=self.seed)
         closed, ended, unreachable = self.stations.closed, m.ended_because, []
         if closed:  # issue 30: the part it could reach (EmbodiedResult's fields)
+            cut_off = self._team_finished_without_root(ended)
+            if cut_off is not None:
+                found, ended = self._cut_off_outcome(cut_off, true_edges), "completed"
             mapped = set(found["map_edges"])
-            reachable, unreachable = reachable_part(true_edges, self.spec.root, closed, mapped)
-            found["map_correct"] = m.declared is not None and reachable <= mapped <= true_edges
+            reachable, unreachable = reachable_part(
+                true_edges, self.spec.root, closed, mapped,
+                cut_off=[v for _, v, _ in (cut_off or {}).values()])
+            found["map_correct"] = found["completed"] and reachable <= mapped <= true_edges
             if ended == "completed" and unreachable:
                 ended = "completed reachable part"
         return EmbodiedResult(

@@ -5,7 +5,9 @@ Robots wait in a depot outside the arena and are put on the root centre one at a
 whenever the root is free: no launched robot that is still at work stands within
 ``ROOT_CLEAR_M`` of it, and (with vertex entry) no robot holds it. Each starts with
 compass heading 0 along the world's +x, the common reference direction of the
-incidence angles. A robot switched off while it waits is never launched.
+incidence angles. A robot switched off while it waits is never launched, and neither is
+any robot once the root is closed (issue 30: a body stands in its area; the robots left
+in the depot are then done, :attr:`~mjswarm.experiments.metrics.Roster.unlaunched`).
 """
 
 from __future__ import annotations
@@ -54,6 +56,13 @@ class Launching(LoopFunctions):
 
     def before_step(self, loop: Loop) -> None:
         if not self.queue:
+            return
+        if self.root in self.stations.closed:
+            for i in self.queue:
+                self.roster.unlaunched.add(i)
+                self.roster.finished.add(i)
+                loop.event(f"R{i + 1} cannot be launched: {self.root} is closed", i)
+            self.queue.clear()
             return
         now = self.world.time_s
         if now - self.last_launch_s < self.interval_s:

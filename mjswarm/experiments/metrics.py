@@ -33,13 +33,20 @@ from mjswarm.worlds.loop import Loop, LoopFunctions
 
 class Roster:
     """What the loop functions of one run share about the team, learnt from reports and
-    from the world (never from controllers): who is done (stopped, declared, switched off
-    or docked) and when a robot last reached a vertex (or was launched)."""
+    from the world (never from controllers): who is done (stopped, declared, cut off
+    with its part finished, switched off, never to be launched or docked) and when a
+    robot last reached a vertex (or was launched)."""
 
     def __init__(self, docked=()) -> None:
         self.docked = frozenset(docked)
-        self.finished: set[int] = set()  # stopped, declared or switched off
-        self.failed: set[int] = set()
+        #: stopped, declared, cut off, switched off or never to be launched
+        self.finished: set[int] = set()
+        self.failed: set[int] = set()  # switched off (faults)
+        #: robots cut off from the root that finished their part (issue 30): robot ->
+        #: (time s, the vertex it stands on, its map as pairs of beacon ids)
+        self.cut_off: dict[int, tuple[float, str, tuple]] = {}
+        #: robots of the depot that can never be launched: the root closed (issue 30)
+        self.unlaunched: set[int] = set()
         self.last_progress_s = 0.0
 
     def is_done(self, i: int) -> bool:
@@ -133,6 +140,11 @@ class ExplorationMetrics(LoopFunctions):
             self.roster.finished.add(i)
             loop.event(f"R{i + 1} declares completion at {vertex}", i)
             loop.event(f"R{i + 1} declared completion at {vertex}")
+        elif call.action == "cut off":
+            self.roster.cut_off[i] = (now, vertex, call.map_edges)
+            self.roster.finished.add(i)
+            loop.event(f"R{i + 1} finished the part it can reach at {vertex} "
+                       "(cut off from the root)", i)
 
     def _heading(self, heading: float | None, true_yaw: float) -> None:
         """``heading_error_deg``: odometry against the truth, on lanes and at vertex calls
@@ -177,21 +189,26 @@ class ExplorationMetrics(LoopFunctions):
 
 def reachable_part(edges: Iterable[tuple[str, str]], root: str,
                    closed: Mapping[str, tuple[int, float]],
-                   mapped: Iterable[tuple[str, str]] = ()) -> tuple[set[tuple[str, str]],
-                                                                    list[dict]]:
+                   mapped: Iterable[tuple[str, str]] = (),
+                   cut_off: Iterable[str] = ()) -> tuple[set[tuple[str, str]], list[dict]]:
     """Ground truth of a run with closed vertices (issue 30; ``closed``: vertex -> (robot
-    index whose body closed it, time s), as the stations recorded them).
+    index whose body closed it, time s), as the stations recorded them; ``cut_off``:
+    where the robots that finished their part stand, when the root closed).
 
-    Returns the edges (sorted pairs) among the vertices reachable from ``root`` without
-    entering a closed vertex (the part a team can finish: empty if the root itself
-    closed), and every other edge the team could not reach, with why:
+    Returns the edges (sorted pairs) among the vertices reachable from ``root`` or from a
+    vertex of ``cut_off`` without entering a closed vertex (the part a team can finish:
+    empty if the root itself closed with nobody out), and every other edge the team
+    could not reach, with why:
     ``{"edge": [u, v], "why": text}``, the why naming the closed vertex it touches, or
     the closed vertices it lies beyond. An edge of ``mapped`` (the declared map, sorted
     pairs) was reached, before its vertex closed, and is not listed."""
     mapped = set(mapped)
     g = nx.Graph(list(edges))
     open_part = g.subgraph(set(g) - set(closed))
-    part = set() if root in closed else nx.node_connected_component(open_part, root)
+    part = set()
+    for source in [*cut_off, *([] if root in closed else [root])]:
+        if source not in part:
+            part |= nx.node_connected_component(open_part, source)
 
     def closed_by(v: str) -> str:
         robot, at_s = closed[v]

@@ -390,14 +390,17 @@ class StationService(LoopFunctions):
     def _turned_back(self, i: int, from_lane: bool) -> None:
         """Robot ``i`` walks back along its edge (:mod:`algorithms.exploration.entry`, step
         5): short of its corridor it gets the vertex behind back at once, unless the
-        station gave it to another robot (a swap: no answer, and it goes on); else it asks
+        station gave it to another robot (a swap: no answer, and it goes on; if that robot
+        has stopped for good since, the vertex is free and its own again); else it asks
         for it as from a centre, and the grant tells it when it may turn, or enter."""
         back = self.came_from[i]
-        if not from_lane and self.leaving[i] == back and self.stations.holder.get(back) != i:
+        holder = self.stations.holder.get(back)
+        if not from_lane and self.leaving[i] == back and holder not in (None, i):
             return
         self.awaiting_clear.discard(i)
         self.stations.release(i, self.target[i])
         if self.leaving[i] == back:  # it had not left that area: it is its own again
+            self.stations.occupy(i, back)
             self.leaving[i], self.target[i] = None, back
             self.uplink.reply(i, EntryGranted(clear=True))
         else:  # from its lane, or its corridor: as a request from a centre
