@@ -328,10 +328,11 @@ def test_embodied_robot_cut_off_by_a_closed_root_finishes_its_part():
     R1 is switched off at 320 s turning on the root's centre, closing it, while R2 is in
     v3's corridor on its way to the root. The station gives R2 v3 back (its swap partner
     stopped for good), R2 walks back, finds every end of its reach finished and says it is
-    cut off; the team's completion is its map, which covers its component of the arena
-    without the root, and the result names the rest."""
+    cut off; nobody declares: the team's completion is its map, which covers its
+    component of the arena without the root, and the result names the rest."""
     import networkx as nx
 
+    from mjswarm.cli.explore import summary
     from mjswarm.experiments.embodied import EmbodiedConfig
     from mjswarm.experiments.exploration import explore_embodied
     from mjswarm.experiments.faults import parse_fault
@@ -341,11 +342,38 @@ def test_embodied_robot_cut_off_by_a_closed_root_finishes_its_part():
         speed_m_s=0.2, physics="kinematic", faults=[parse_fault("robot:1@320")]))
     assert result.ended_because == "completed reachable part"
     assert result.closed_vertices[0]["vertex"] == spec.root and result.collisions == 0
-    assert result.declared_by == 2 and result.map_correct
+    assert result.declared_by is None and result.map_correct
+    [cut] = result.cut_off_robots
+    assert cut["robot"] == 2 and cut["at_s"] > 320.0
     assert [s["robot"] for s in result.stopped_robots] == [1]
     g = spec.graph()
-    part = nx.node_connected_component(g.subgraph(set(g) - {spec.root}), result.declared_at)
+    part = nx.node_connected_component(g.subgraph(set(g) - {spec.root}), cut["vertex"])
     inside = {tuple(sorted(e)) for e in g.subgraph(part).edges}
     assert inside and inside <= set(result.map_edges)
     named = {tuple(e["edge"]) for e in result.unreachable_edges}
     assert named == {tuple(sorted(e)) for e in g.edges} - set(result.map_edges)
+    d = result.to_dict()
+    d["world"], d["recording"], d["video"] = "embodied", None, None
+    assert (f"completed the reachable part: every robot left is cut off from the root and "
+            f"finished its part (R2 at {cut['vertex']})") in summary(d)
+
+
+def test_a_body_where_corridors_still_meet_closes_the_vertex():
+    """wheel:6, 3 robots at 0.15 m/s (kinematic): R3 fails at 76 s on its spoke 0.28 m from
+    rim vertex r5, beyond r5's area but where the spoke's corridor still meets the rim's
+    (they meet at 60 degrees: the walls start 0.38 m out, ``junction_depths``). Before,
+    R1 drove along the rim into the body (1 contact) and the run stalled; now the body
+    closes r5 and the team completes the reachable part with no contact."""
+    from mjswarm.arena.geometry import VERTEX_CLEAR_RADIUS_M, junction_depths
+    from mjswarm.experiments.embodied import EmbodiedConfig
+    from mjswarm.experiments.exploration import explore_embodied
+    from mjswarm.experiments.faults import parse_fault
+
+    square = junction_depths(load_arena("lattice:3x3"))
+    assert set(square.values()) == {VERTEX_CLEAR_RADIUS_M}  # 90 degrees: the area only
+    spec = load_arena("wheel:6")
+    assert junction_depths(spec)[("r5", "c")] > 0.3
+    result = explore_embodied(spec, 3, config=EmbodiedConfig(
+        speed_m_s=0.15, physics="kinematic", faults=[parse_fault("robot:3@76")]))
+    assert result.collisions == 0 and result.ended_because == "completed reachable part"
+    assert result.map_correct and [c["vertex"] for c in result.closed_vertices] == ["r5"]

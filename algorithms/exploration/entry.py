@@ -20,6 +20,10 @@ and every message is counted with the radio's. The protocol, from the robot's si
    waits where its lane's wall ends, out of ``w``'s area.
 4. A robot that stops for good sends :class:`Halted`: the station drops its request and
    holds (a body left in a vertex area keeps that vertex closed: the station sees it).
+   So does a robot cut off from the root that finished its part (``CUT_OFF``): it
+   stands on its vertex's centre for good, and a robot of its component that still
+   wants that vertex is answered as for any closed vertex (step 7), instead of waiting
+   for ever.
 5. Relays (rule 6 of :mod:`algorithms.exploration.relay`, ours). A relay's last leg ends
    part-way, where its requester is: its :class:`EntryRequest` says so (``part_way``),
    and the station lets it onto the lane at once without giving it the vertex ahead

@@ -567,6 +567,9 @@ class Explorer(Controller):
             self._events.append(Declared(mapped))
         elif decision.action == "cut off":  # it stands for good; VertexCalled tells
             self.finished = True
+            if self.rule is not None:  # a body for good on a centre: that vertex closes
+                out.append(Message(Halted("cut off from the root, its part finished"),
+                                   STATION))
         else:
             raise ValueError(f"the strategy answered an unknown decision {decision!r}")
 

@@ -177,6 +177,16 @@ def vertex_fans(spec: ArenaSpec) -> dict[str, list[tuple[float, str]]]:
     return fans
 
 
+def junction_depths(spec: ArenaSpec) -> dict[tuple[str, str], float]:
+    """For every directed edge ``(u, v)``: how far (m, along the edge from ``u``'s centre)
+    the edge's corridor is still shared with its neighbours at ``u``, up to where both its
+    walls have started (:func:`wall_setback` of both side angles). A body stopped nearer
+    stands where robots of the other edges turn in and out: the vertex's, not the edge's
+    (``mjswarm.experiments.stations``)."""
+    return {e: max(wall_setback(left), wall_setback(right))
+            for e, (left, right) in side_angles(spec).items()}
+
+
 def side_angles(spec: ArenaSpec) -> dict[tuple[str, str], tuple[float, float]]:
     """For every directed edge ``(u, v)``: (left, right) neighbour angles at ``u`` (rad).
 

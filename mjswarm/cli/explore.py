@@ -313,8 +313,12 @@ def summary(result: dict) -> str:
     unreachable = result.get("unreachable_edges") or []
     if result["completed"] and unreachable:  # closed vertices: the part it could reach
         verdict = "covering" if result["map_correct"] else "NOT covering"
-        by = "no robot was out when the root closed" if result["declared_by"] is None else \
-            f"R{result['declared_by']} declared completion at {result['declared_at']}"
+        cut = result.get("cut_off_robots") or []
+        by = f"R{result['declared_by']} declared completion at {result['declared_at']}"
+        if result["declared_by"] is None:  # the team's verdict: nobody could declare
+            by = "every robot left is cut off from the root and finished its part (" + \
+                ", ".join(f"R{c['robot']} at {c['vertex']}" for c in cut) + ")" if cut \
+                else "no robot was out when the root closed"
         lines = [head,
                  f"completed the reachable part: {by}; makespan {result['makespan']:g} "
                  "edges (most by any robot)",

@@ -150,6 +150,13 @@ class EmbodiedResult(ExplorationResult):
     #: edges (edges mapped before their vertex closed may be in it too).
     closed_vertices: list[dict] = field(default_factory=list)
     unreachable_edges: list[dict] = field(default_factory=list)
+    #: robots cut off from the root that finished the part they could reach (``CUT_OFF``):
+    #: ``{"robot": R, "vertex": v, "at_s": t}``. When every robot left is cut off (or
+    #: cannot be launched: the root closed), nobody declares; the run is the team's
+    #: completion of the reachable part, its map the union of their maps
+    #: (:meth:`mjswarm.experiments.exploration.EmbodiedExploration._team_cut_off`), and
+    #: ``declared_by`` is None.
+    cut_off_robots: list[dict] = field(default_factory=list)
 
 
 def same_lane_bearing(range_m: float) -> float:

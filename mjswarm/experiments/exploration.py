@@ -316,16 +316,19 @@ class EmbodiedExploration(LoopFunctions):
                       if b.id is not None], BEACON_LABEL)
 
     # ------------------------------------------------------------------ result
-    def _team_finished_without_root(self, ended: str) -> dict | None:
-        """The team's completion when the root closed (issue 30), or None. No robot can
-        declare then (its reach never holds the root: ``incidence_matrix``'s rule), so
-        the verdict is the experimenter's, as "all robots stopped" is: every robot
-        failed, cannot be launched, or is cut off and finished the part it can reach
-        (``CUT_OFF``: that part is its whole component of the graph without the closed
-        vertices), and one robot at least did not fail (a team whose robots all failed
-        finished nothing). Returns the cut-off robots (:attr:`Roster.cut_off`)."""
+    def _team_cut_off(self, ended: str) -> dict | None:
+        """The team's completion when no robot left can get to the root (issue 30), or
+        None. The root closed, or every robot that could still reach it failed: no robot
+        can declare then (its reach never holds the root: ``incidence_matrix``'s rule),
+        so the verdict is the experimenter's, as "all robots stopped" is: every robot
+        failed, cannot be launched (the root closed), or is cut off and finished the part
+        it can reach (``CUT_OFF``: that part is its whole component of the graph without
+        the closed vertices), and one robot at least did not fail (a team whose robots
+        all failed finished nothing). The part the team could still reach is then the
+        cut-off robots' components. Returns the cut-off robots
+        (:attr:`Roster.cut_off`)."""
         r = self.roster
-        if ended != "all robots stopped" or self.spec.root not in self.stations.closed:
+        if ended != "all robots stopped":
             return None
         team = [i for i in range(self.world.n) if i not in r.docked]
         if any(i not in r.failed and i not in r.unlaunched and i not in r.cut_off
@@ -334,14 +337,11 @@ class EmbodiedExploration(LoopFunctions):
         return r.cut_off
 
     def _cut_off_outcome(self, cut_off: dict, true_edges: set) -> dict:
-        """:func:`outcome` for a team finished without its root: the map is the union of
-        the cut-off robots' maps, declared by the last of them to finish (by nobody if
-        none was out when the root closed)."""
+        """:func:`outcome` for a team cut off from its root: completed, declared by
+        nobody, its map the union of the cut-off robots' maps."""
         m = self.metrics
-        last = max(cut_off, key=lambda i: cut_off[i][0], default=None)
-        declared = None if last is None else (cut_off[last][0], last, cut_off[last][1])
         union = sorted({e for _, _, edges in cut_off.values() for e in edges})
-        found = outcome(strategy_name(self.minds), declared, union,
+        found = outcome(strategy_name(self.minds), None, union,
                         max(len(p) - 1 for p in m.paths), m.paths, m.beacon_vertex,
                         true_edges, arena=self.spec.name, root=self.spec.root,
                         edge_time="physics", seed=self.seed)
@@ -360,13 +360,12 @@ class EmbodiedExploration(LoopFunctions):
                         root=self.spec.root, edge_time="physics", seed=self.seed)
         closed, ended, unreachable = self.stations.closed, m.ended_because, []
         if closed:  # issue 30: the part it could reach (EmbodiedResult's fields)
-            cut_off = self._team_finished_without_root(ended)
+            cut_off, sources = self._team_cut_off(ended), [(self.spec.root, math.inf)]
             if cut_off is not None:
                 found, ended = self._cut_off_outcome(cut_off, true_edges), "completed"
+                sources = [(v, t) for t, v, _ in cut_off.values()]
             mapped = set(found["map_edges"])
-            reachable, unreachable = reachable_part(
-                true_edges, self.spec.root, closed, mapped,
-                cut_off=[v for _, v, _ in (cut_off or {}).values()])
+            reachable, unreachable = reachable_part(true_edges, sources, closed, mapped)
             found["map_correct"] = found["completed"] and reachable <= mapped <= true_edges
             if ended == "completed" and unreachable:
                 ended = "completed reachable part"
@@ -393,6 +392,8 @@ class EmbodiedExploration(LoopFunctions):
             closed_vertices=[{"vertex": v, "robot": r + 1, "at_s": round(t, 2)}
                              for v, (r, t) in self.closed_items()],
             unreachable_edges=unreachable,
+            cut_off_robots=[{"robot": i + 1, "vertex": v, "at_s": round(t, 2)}
+                            for i, (t, v, _) in sorted(self.roster.cut_off.items())],
             stopped_robots=list(m.stopped),
             heading_error_deg=round(math.degrees(m.heading_error_rad), 3),
             faults=self.faults.log(),

@@ -13,9 +13,10 @@ Forms (times in simulated seconds; robots numbered from 1, as in every output):
     reach and the result names the edges it could not (``unreachable_edges``). A body on
     a lane is passed on the opposite lane (:mod:`algorithms.exploration.entry`, step 6).
     A body that closes the root leaves the robots of the depot unlaunched and those out
-    cut off; each of these finishes the part it can still reach, and the run ends
-    ``completed reachable part`` once all have (the rule in
-    :meth:`~mjswarm.experiments.exploration.EmbodiedExploration._team_finished_without_root`).
+    cut off (as a body can cut the last live robots off an open root); each of these
+    finishes the part it can still reach, and the run ends ``completed reachable
+    part`` once all have (the rule in
+    :meth:`~mjswarm.experiments.exploration.EmbodiedExploration._team_cut_off`).
 ``beacon:V@T``
     The beacon at vertex V is wiped at T (its contents and id are gone). The next robot
     there drops a new beacon under a new id; robots that knew the old one keep both

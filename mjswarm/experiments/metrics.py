@@ -187,16 +187,18 @@ class ExplorationMetrics(LoopFunctions):
         return None if self.declared is None else max(len(p) - 1 for p in self.paths)
 
 
-def reachable_part(edges: Iterable[tuple[str, str]], root: str,
+def reachable_part(edges: Iterable[tuple[str, str]],
+                   sources: Iterable[tuple[str, float]],
                    closed: Mapping[str, tuple[int, float]],
-                   mapped: Iterable[tuple[str, str]] = (),
-                   cut_off: Iterable[str] = ()) -> tuple[set[tuple[str, str]], list[dict]]:
+                   mapped: Iterable[tuple[str, str]] = ()) -> tuple[set[tuple[str, str]],
+                                                                    list[dict]]:
     """Ground truth of a run with closed vertices (issue 30; ``closed``: vertex -> (robot
-    index whose body closed it, time s), as the stations recorded them; ``cut_off``:
-    where the robots that finished their part stand, when the root closed).
+    index whose body closed it, time s), as the stations recorded them; ``sources``:
+    where the team can still go from, and until when (s): the root until the end
+    (``math.inf``), or each robot cut off from it where and when it finished its part).
 
-    Returns the edges (sorted pairs) among the vertices reachable from ``root`` or from a
-    vertex of ``cut_off`` without entering a closed vertex (the part a team can finish:
+    Returns the edges (sorted pairs) among the vertices reachable from a source without
+    entering a vertex closed before that source's time (the part a team can finish:
     empty if the root itself closed with nobody out), and every other edge the team
     could not reach, with why:
     ``{"edge": [u, v], "why": text}``, the why naming the closed vertex it touches, or
@@ -206,9 +208,10 @@ def reachable_part(edges: Iterable[tuple[str, str]], root: str,
     g = nx.Graph(list(edges))
     open_part = g.subgraph(set(g) - set(closed))
     part = set()
-    for source in [*cut_off, *([] if root in closed else [root])]:
-        if source not in part:
-            part |= nx.node_connected_component(open_part, source)
+    for source, until_s in sources:
+        shut = {v for v, (_, at_s) in closed.items() if at_s < until_s}
+        if source not in part and source not in shut:
+            part |= nx.node_connected_component(g.subgraph(set(g) - shut), source)
 
     def closed_by(v: str) -> str:
         robot, at_s = closed[v]

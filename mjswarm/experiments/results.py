@@ -47,15 +47,14 @@ def outcome(strategy: str, declared: tuple[float, int, str] | None,
             true_edges: set[tuple[str, str]], **run) -> dict:
     """The :class:`ExplorationResult` fields every world computes the same way, given the
     strategy's name, the declaration ``(time, robot index, vertex)`` or None, the
-    declaring robot's map (pairs of beacon ids), the makespan, each robot's path, where
+    declaring robot's map (pairs of beacon ids; empty when nobody declared, but for a team
+    cut off from its root), the makespan, each robot's path, where
     each beacon was dropped, the true edges (sorted pairs) and the run's own fields
     (``arena``, ``root``, ``edge_time``, ``seed``). The map is translated from beacon ids
     to arena vertices."""
     per_robot = [len(p) - 1 for p in paths]
-    map_edges: list[tuple[str, str]] = []
-    if declared is not None:
-        pairs = ((beacon_vertex[a], beacon_vertex[b]) for a, b in declared_map)
-        map_edges = sorted((u, v) if u <= v else (v, u) for u, v in pairs)
+    pairs = ((beacon_vertex[a], beacon_vertex[b]) for a, b in declared_map)
+    map_edges = sorted((u, v) if u <= v else (v, u) for u, v in pairs)
     return dict(
         run,
         strategy=strategy,

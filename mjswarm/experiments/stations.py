@@ -53,8 +53,10 @@ robot held still on its lane for 5 s creeps on, guarded by its front IR, since v
 entry leaves nobody else on its lane).
 
 **Closed vertices** (issue 30, item 3: a body that cannot be passed). A robot that stops
-for good (a fault switches it off, or it halts) with its body in a vertex area keeps that
-vertex held for ever: the vertex is *closed* (:meth:`StationService._release`; the station
+for good (a fault switches it off, it halts, or it is cut off from the root with its part
+finished) with its body in a vertex area, or in the stretch of its corridor still shared
+with the vertex's other edges (:func:`~mjswarm.arena.geometry.junction_depths`: edges
+less than about 84 degrees apart), keeps that vertex held for ever: the vertex is *closed* (:meth:`StationService._release`; the station
 learns it from the switch-off here, a real one would from a body in its area that has
 gone silent). Its station then answers every request for it with
 :class:`~algorithms.exploration.entry.EntryBlocked` instead of a grant: the requests in
@@ -96,7 +98,7 @@ from algorithms.exploration.entry import (
 )
 from algorithms.exploration.events import VertexCalled
 from mjswarm.arena import ArenaSpec
-from mjswarm.arena.geometry import VERTEX_CLEAR_RADIUS_M, vertex_fans
+from mjswarm.arena.geometry import VERTEX_CLEAR_RADIUS_M, junction_depths, vertex_fans
 from mjswarm.worlds.loop import Loop, LoopFunctions
 
 #: A robot is on a vertex when within this distance of its centre (m).
@@ -239,6 +241,7 @@ class StationService(LoopFunctions):
     def __init__(self, spec: ArenaSpec, world, uplink, nearest: NearestVertex,
                  avoid: bool) -> None:
         self.spec, self.world, self.uplink = spec, world, uplink
+        self.fans, self.junctions = vertex_fans(spec), junction_depths(spec)
         self.nearest, self.avoid = nearest, avoid
         self.stations = VertexStations(spec)
         k = world.n
@@ -419,10 +422,22 @@ class StationService(LoopFunctions):
         self.leaving[i] = None
         self.awaiting_clear.discard(i)
         self.pass_waiting.discard(i)
-        if distance < VERTEX_CLEAR_RADIUS_M:
+        if distance < VERTEX_CLEAR_RADIUS_M or distance < self._junction_depth(i, vertex):
             self.stations.occupy(i, vertex)
             self._close(vertex, i)
         self._tell_clear()
+
+    def _junction_depth(self, i: int, vertex: str) -> float:
+        """How far from ``vertex``'s centre the corridor robot ``i`` stands in is still
+        shared with the vertex's other edges (m; :func:`~mjswarm.arena.geometry.
+        junction_depths`): beyond the vertex area where edges meet at less than about
+        84 degrees. A body there blocks robots turning in and out of those edges too, and
+        cannot be passed, so it closes the vertex as one in its area does."""
+        x, y = self.world.true_poses()[i, :2] - self.spec.vertices[vertex]
+        heading = math.atan2(y, x)
+        _, towards = min(self.fans[vertex], key=lambda fan: abs(
+            math.remainder(fan[0] - heading, 2 * math.pi)))
+        return self.junctions[(vertex, towards)]
 
     def _close(self, vertex: str, body: int) -> None:
         """``vertex`` is closed by robot ``body``'s body (module docstring): the requests
