@@ -154,7 +154,7 @@ class EmbodiedResult(ExplorationResult):
     #: ``{"robot": R, "vertex": v, "at_s": t}``. When every robot left is cut off (or
     #: cannot be launched: the root closed), nobody declares; the run is the team's
     #: completion of the reachable part, its map the union of their maps
-    #: (:meth:`mjswarm.experiments.exploration.EmbodiedExploration._team_cut_off`), and
+    #: (:func:`mjswarm.experiments.metrics.team_cut_off`), and
     #: ``declared_by`` is None.
     cut_off_robots: list[dict] = field(default_factory=list)
 

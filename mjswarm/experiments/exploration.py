@@ -118,7 +118,12 @@ from mjswarm.experiments.embodied import (  # noqa: F401 - the experiment's publ
 )
 from mjswarm.experiments.faults import Faults
 from mjswarm.experiments.launching import Launching, depot
-from mjswarm.experiments.metrics import ExplorationMetrics, Roster, reachable_part
+from mjswarm.experiments.metrics import (
+    ExplorationMetrics,
+    Roster,
+    reachable_part,
+    team_cut_off,
+)
 from mjswarm.experiments.minds import make_minds, strategy_name
 from mjswarm.experiments.radio_exploration import NEED, infeasible_reason
 from mjswarm.experiments.results import outcome
@@ -316,26 +321,6 @@ class EmbodiedExploration(LoopFunctions):
                       if b.id is not None], BEACON_LABEL)
 
     # ------------------------------------------------------------------ result
-    def _team_cut_off(self, ended: str) -> dict | None:
-        """The team's completion when no robot left can get to the root (issue 30), or
-        None. The root closed, or every robot that could still reach it failed: no robot
-        can declare then (its reach never holds the root: ``incidence_matrix``'s rule),
-        so the verdict is the experimenter's, as "all robots stopped" is: every robot
-        failed, cannot be launched (the root closed), or is cut off and finished the part
-        it can reach (``CUT_OFF``: that part is its whole component of the graph without
-        the closed vertices), and one robot at least did not fail (a team whose robots
-        all failed finished nothing). The part the team could still reach is then the
-        cut-off robots' components. Returns the cut-off robots
-        (:attr:`Roster.cut_off`)."""
-        r = self.roster
-        if ended != "all robots stopped":
-            return None
-        team = [i for i in range(self.world.n) if i not in r.docked]
-        if any(i not in r.failed and i not in r.unlaunched and i not in r.cut_off
-               for i in team) or all(i in r.failed for i in team):
-            return None  # a robot stopped for another reason, or nobody is left
-        return r.cut_off
-
     def _cut_off_outcome(self, cut_off: dict, true_edges: set) -> dict:
         """:func:`outcome` for a team cut off from its root: completed, declared by
         nobody, its map the union of the cut-off robots' maps."""
@@ -360,7 +345,8 @@ class EmbodiedExploration(LoopFunctions):
                         root=self.spec.root, edge_time="physics", seed=self.seed)
         closed, ended, unreachable = self.stations.closed, m.ended_because, []
         if closed:  # issue 30: the part it could reach (EmbodiedResult's fields)
-            cut_off, sources = self._team_cut_off(ended), [(self.spec.root, math.inf)]
+            cut_off = team_cut_off(self.roster, self.world.n, ended)
+            sources = [(self.spec.root, math.inf)]
             if cut_off is not None:
                 found, ended = self._cut_off_outcome(cut_off, true_edges), "completed"
                 sources = [(v, t) for t, v, _ in cut_off.values()]

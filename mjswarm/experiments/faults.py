@@ -16,7 +16,7 @@ Forms (times in simulated seconds; robots numbered from 1, as in every output):
     cut off (as a body can cut the last live robots off an open root); each of these
     finishes the part it can still reach, and the run ends ``completed reachable
     part`` once all have (the rule in
-    :meth:`~mjswarm.experiments.exploration.EmbodiedExploration._team_cut_off`).
+    :func:`~mjswarm.experiments.metrics.team_cut_off`).
 ``beacon:V@T``
     The beacon at vertex V is wiped at T (its contents and id are gone). The next robot
     there drops a new beacon under a new id; robots that knew the old one keep both

@@ -187,6 +187,25 @@ class ExplorationMetrics(LoopFunctions):
         return None if self.declared is None else max(len(p) - 1 for p in self.paths)
 
 
+def team_cut_off(roster: Roster, n_robots: int, ended: str) -> dict | None:
+    """The team's completion when no robot left can get to the root (issue 30), or
+    None. The root closed, or every robot that could still reach it failed: no robot
+    can declare then (its reach never holds the root: ``incidence_matrix``'s rule), so
+    the verdict is the experimenter's, as "all robots stopped" (``ended``) is: every
+    robot failed, cannot be launched (the root closed), or is cut off and finished the
+    part it can reach (``CUT_OFF``: that part is its whole component of the graph
+    without the closed vertices), and one robot at least did not fail (a team whose
+    robots all failed finished nothing). The part the team could still reach is then
+    the cut-off robots' components. Returns the cut-off robots (:attr:`Roster.cut_off`)."""
+    if ended != "all robots stopped":
+        return None
+    team = [i for i in range(n_robots) if i not in roster.docked]
+    if any(i not in roster.failed and i not in roster.unlaunched and i not in roster.cut_off
+           for i in team) or all(i in roster.failed for i in team):
+        return None  # a robot stopped for another reason, or nobody is left
+    return roster.cut_off
+
+
 def reachable_part(edges: Iterable[tuple[str, str]],
                    sources: Iterable[tuple[str, float]],
                    closed: Mapping[str, tuple[int, float]],
