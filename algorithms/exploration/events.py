@@ -22,9 +22,9 @@ class Declared(NamedTuple):
 class VertexCalled(NamedTuple):
     """The robot called its strategy at the vertex it stands on: whether it had just
     arrived by an edge (else a launch, an idle wake-up or a walk back), what it decided
-    (``"go"`` along ``angle_rad``, ``"idle"``, ``"done"`` or ``"cut off"``), the beacon's id after the
-    call, what the beacon holds (its text, for reviewers) and the robot's map then (pairs
-    of beacon ids)."""
+    (``"go"`` along ``angle_rad``, ``"idle"``, ``"done"`` or ``"cut off"``), the beacon's
+    id after the call, what the beacon holds (its text, for reviewers) and the robot's map
+    then (pairs of beacon ids)."""
 
     arrived: bool
     action: str

@@ -56,8 +56,8 @@ every end of its reach is completed or blocked (:meth:`IncidenceMatrix.reach_fin
 its reach is the whole of its component of the graph without the closed vertices (no
 end of it leads anywhere else), which no robot can enter or leave any more; it has
 finished that part and stops (``CUT_OFF``). Only the team can tell that nothing is left
-(no robot knows whether others, cut off elsewhere, still work): the experiment's rule
-for a closed root is in ``mjswarm.experiments.exploration``. The bit set is 0 in every
+(no robot knows whether others, cut off elsewhere, still work): the embodied
+experiment's rule for that is ``team_cut_off`` in ``mjswarm.experiments.metrics``. The bit set is 0 in every
 run without closed vertices, and every query then takes the old path.
 """
 

@@ -313,12 +313,14 @@ def summary(result: dict) -> str:
     unreachable = result.get("unreachable_edges") or []
     if result["completed"] and unreachable:  # closed vertices: the part it could reach
         verdict = "covering" if result["map_correct"] else "NOT covering"
-        cut = result.get("cut_off_robots") or []
-        by = f"R{result['declared_by']} declared completion at {result['declared_at']}"
-        if result["declared_by"] is None:  # the team's verdict: nobody could declare
-            by = "every robot left is cut off from the root and finished its part (" + \
-                ", ".join(f"R{c['robot']} at {c['vertex']}" for c in cut) + ")" if cut \
-                else "no robot was out when the root closed"
+        cut = ", ".join(f"R{c['robot']} at {c['vertex']}"
+                        for c in result.get("cut_off_robots") or [])
+        if result["declared_by"] is not None:
+            by = f"R{result['declared_by']} declared completion at {result['declared_at']}"
+        elif cut:  # the team's verdict: nobody could declare
+            by = f"every robot left is cut off from the root and finished its part ({cut})"
+        else:
+            by = "no robot was out when the root closed"
         lines = [head,
                  f"completed the reachable part: {by}; makespan {result['makespan']:g} "
                  "edges (most by any robot)",

@@ -321,18 +321,6 @@ class EmbodiedExploration(LoopFunctions):
                       if b.id is not None], BEACON_LABEL)
 
     # ------------------------------------------------------------------ result
-    def _cut_off_outcome(self, cut_off: dict, true_edges: set) -> dict:
-        """:func:`outcome` for a team cut off from its root: completed, declared by
-        nobody, its map the union of the cut-off robots' maps."""
-        m = self.metrics
-        union = sorted({e for _, _, edges in cut_off.values() for e in edges})
-        found = outcome(strategy_name(self.minds), None, union,
-                        max(len(p) - 1 for p in m.paths), m.paths, m.beacon_vertex,
-                        true_edges, arena=self.spec.name, root=self.spec.root,
-                        edge_time="physics", seed=self.seed)
-        found["completed"] = True
-        return found
-
     def result(self, loop: Loop | None = None, wall: float = 0.0) -> EmbodiedResult:
         """The measurements so far (``wall``: wall-clock seconds spent, for the rates)."""
         m, sim, radio = self.metrics, self.sim, self.world.radio
@@ -340,16 +328,21 @@ class EmbodiedExploration(LoopFunctions):
             self.tether_truth.shares()
         truth = self.tether_truth
         true_edges = {tuple(sorted(e)) for e in self.spec.edges}
-        found = outcome(strategy_name(self.minds), m.declared, m.declared_map, m.makespan,
+        closed, ended, unreachable = self.stations.closed, m.ended_because, []
+        # issue 30: a team cut off from its root completes with nobody declaring, its map
+        # the union of the cut-off robots' maps (team_cut_off)
+        cut_off = team_cut_off(self.roster, self.world.n, ended) if closed else None
+        declared_map, makespan = m.declared_map, m.makespan
+        if cut_off is not None:
+            declared_map = sorted({e for _, _, edges in cut_off.values() for e in edges})
+            makespan, ended = max(len(p) - 1 for p in m.paths), "completed"
+        found = outcome(strategy_name(self.minds), m.declared, declared_map, makespan,
                         m.paths, m.beacon_vertex, true_edges, arena=self.spec.name,
                         root=self.spec.root, edge_time="physics", seed=self.seed)
-        closed, ended, unreachable = self.stations.closed, m.ended_because, []
-        if closed:  # issue 30: the part it could reach (EmbodiedResult's fields)
-            cut_off = team_cut_off(self.roster, self.world.n, ended)
-            sources = [(self.spec.root, math.inf)]
-            if cut_off is not None:
-                found, ended = self._cut_off_outcome(cut_off, true_edges), "completed"
-                sources = [(v, t) for t, v, _ in cut_off.values()]
+        if closed:  # the part it could reach (EmbodiedResult's fields)
+            found["completed"] = found["completed"] or cut_off is not None
+            sources = [(self.spec.root, math.inf)] if cut_off is None else [
+                (v, t) for t, v, _ in cut_off.values()]
             mapped = set(found["map_edges"])
             reachable, unreachable = reachable_part(true_edges, sources, closed, mapped)
             found["map_correct"] = found["completed"] and reachable <= mapped <= true_edges
