@@ -150,3 +150,39 @@ def test_a_robot_turned_back_part_way_arrives_where_it_left_by_the_edge_it_left_
     assert angle_error_deg(nav.arrived_angle, first[0]) < ANGLE_TOLERANCE_DEG
     assert len(nav.edge_angles) == len(first)
     assert max(min(angle_error_deg(a, b) for a in nav.edge_angles) for b in first) < ANGLE_TOLERANCE_DEG
+
+
+def test_leaving_a_vertex_takes_its_own_lane_not_the_corner_of_a_neighbours():
+    """Edges 45 degrees apart (``wheel:4@8`` at ``r3``): where the lane towards ``r0``
+    starts, the end of the lane arriving from ``c`` is within a side sensor's reach. A
+    robot leaving towards ``r0`` whose left sensor finds that corner keeps seeking
+    (issue 27: it had followed it and was lost); its centre sensor on its own lane ends
+    the seek. Positions in the true frame, the robot's odometry set to it."""
+    spec = load_arena("wheel:4@8")
+    sim = Simulation(arena_world_spec(spec, [Pose2D(*spec.vertices["r3"], 0.0)]))
+    cal, conv = calibration(sim.geometry), conventions(sim.geometry)
+    angle = incidence_angle(spec, "r3", "r0")
+    nav = Navigator(cal, conv, angle, SPEED_M_S)
+    nav.odometry.x, nav.odometry.y = spec.vertices["r3"]
+    nav.edge_angles = [incidence_angle(spec, "r3", w) for w in ("r0", "c", "r2")]
+    ours = nav._own_lane(angle)
+    strips = {s.travel: s for s in lane_strips(spec)}
+    own, theirs = strips[("r3", "r0")], strips[("c", "r3")]
+    u = np.array([math.cos(angle), math.sin(angle)])
+    n = np.array([-u[1], u[0]])
+
+    def at(sensor_xy, side_m):  # the pose that puts the sensor ``side_m`` left there
+        xy = np.asarray(sensor_xy) - cal.line_ahead_m * u - side_m * n
+        nav.odometry.x, nav.odometry.y = xy
+        return nav.odometry
+
+    corner = np.asarray(theirs.end) - 0.001 * _unit(theirs.start, theirs.end)
+    assert ours(at(corner, cal.line_spacing_m), (True, False, False)) is False
+    start = np.asarray(own.start) + 0.001 * u
+    assert ours(at(start, 0.0), (False, True, False)) is True
+    assert ours(at(start, 0.0), (True, True, False)) is True
+
+
+def _unit(p, q):
+    d = np.asarray(q, float) - np.asarray(p, float)
+    return d / np.linalg.norm(d)

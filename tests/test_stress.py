@@ -155,6 +155,9 @@ def test_a_lone_robot_keeps_its_heading_over_384_legs():
     # that told the first spoke coming round
     StressRun("fan:3:45@17", 1, 0.2, 0, Noise(wheel_slip=0.05), "dynamic"),
     StressRun("fan:3:45@17", 1, 0.2, 1, NOISES[-1], "kinematic"),
+    # line noise 0.5 mm, 45 degree junction: leaving r3, the left sensor found the corner
+    # of the neighbouring edge's lane first and the robot followed it (lost)
+    StressRun("wheel:4@8", 1, 0.1, 0, Noise(line_m=0.0005), "kinematic"),
 ], ids=str)
 def test_noise_representatives(run):
     result = run.run(max_sim_time_s=1200.0)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from algorithms.navigation.odometry import Odometry
@@ -92,19 +93,22 @@ class Drive:
 class SeekLine:
     """Drive straight along ``heading`` until a line sensor sees a strip.
 
-    ``failed`` is set if none is found within ``max_distance_m``.
+    ``failed`` is set if none is found within ``max_distance_m``. ``ours`` (optional)
+    tells the strip sought from another one: it takes the odometry and the sensors that
+    see a strip, and the seek ends only when it says True.
     """
 
     heading: float
     speed: float
     max_distance_m: float
+    ours: Callable[[Odometry, tuple[bool, bool, bool]], bool] | None = None
     failed: bool = False
     _start: float | None = None
 
     def step(self, odo: Odometry, percept: Percept):
         if self._start is None:
             self._start = odo.distance_m
-        if percept.any_line:
+        if percept.any_line and (self.ours is None or self.ours(odo, percept.line)):
             return None
         if odo.distance_m - self._start > self.max_distance_m:
             self.failed = True

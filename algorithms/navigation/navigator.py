@@ -69,6 +69,8 @@ from algorithms.navigation.odometry import Odometry, RobotCalibration
 from algorithms.navigation.percept import LineFilter, Percept, WallWatch
 
 SHIFT_ANGLE = math.radians(60.0)
+#: The least angle (rad) between two edges of a vertex the arena marks allow.
+MIN_EDGE_GAP = math.radians(45.0)
 #: Top speed (m/s) of the approach to a vertex centre (finding and following the spoke,
 #: the last drive): the spoke's end, which places the robot on the centre, is then seen
 #: within a millimetre of travel per control tick whatever the cruising speed (at 0.2 m/s
@@ -178,7 +180,8 @@ class Navigator:
             raise RuntimeError(f"depart() needs the robot at a vertex, it is {self.state.value}")
         self._plan = deque([
             *self._shift(angle, +1),
-            (SeekLine(angle, self.speed, self.conv.max_seek_m), self._found_lane),
+            (SeekLine(angle, self.speed, self.conv.max_seek_m, self._own_lane(angle)),
+             self._found_lane),
         ])
         self._left = (self.odometry.x, self.odometry.y, angle)
         self.state = NavigatorState.LEAVING
@@ -338,6 +341,46 @@ class Navigator:
         theta = self.odometry.theta
         swing = wrap(theta - self._lane.direction(theta, last=None))
         return {p: beta + swing for p, beta in bearings.items()}
+
+    def _own_lane(self, angle: float):
+        """Leaving along ``angle``: whether the strips the line sensors see now include
+        the lane sought (the left lane of that edge) rather than a lane of a neighbouring
+        edge of this vertex (ours, issue 27). Lanes start where they no longer cross
+        their neighbours' (:func:`mjswarm.arena.geometry.lane_setback`), at 27 cm for
+        edges 45 degrees apart, and there the right lane of the edge 45 degrees to the
+        left comes within 2.5 cm of the lane sought: a robot set off 2.4 degrees off its
+        edge found that lane's corner with its left sensor first and followed it
+        (``wheel:4@8``, 1 robot, 0.1 m/s, line noise 0.5 mm, kinematic, seed 0: lost).
+        A sensor's strip counts as the lane sought when that lane's line is the nearest
+        of the vertex's lane lines (both lanes of every edge measured here, on the
+        robot's side of the centre; positions by odometry from the centre it left). A
+        sensor on the lane sought is nearest it, noise-free or not, so runs whose sensors
+        find their own lane first keep their results. None without the sensor spacing."""
+        spacing = self.cal.line_spacing_m
+        others = [a for a in self.edge_angles if abs(wrap(a - angle)) > MIN_EDGE_GAP / 2.0]
+        if spacing is None or not others:
+            return None
+        cx, cy = self.odometry.x, self.odometry.y
+        offset, ahead = self.conv.lane_offset_m, self.cal.line_ahead_m
+        lanes = [(angle, offset)] + [(a, side * offset) for a in others for side in (1, -1)]
+
+        def nearest_lane(x: float, y: float) -> int:
+            best, which = math.inf, -1
+            for k, (a, lateral) in enumerate(lanes):
+                c, s = math.cos(a), math.sin(a)
+                if (x - cx) * c + (y - cy) * s <= 0.0:
+                    continue
+                d = abs(-(x - cx) * s + (y - cy) * c - lateral)
+                if d < best:
+                    best, which = d, k
+            return which
+
+        def ours(odo: Odometry, line: tuple[bool, bool, bool]) -> bool:
+            c, s = math.cos(odo.theta), math.sin(odo.theta)
+            return any(on and nearest_lane(odo.x + ahead * c - side * s,
+                                           odo.y + ahead * s + side * c) == 0
+                       for on, side in zip(line, (spacing, 0.0, -spacing)))
+        return ours
 
     @property
     def at_vertex_area(self) -> bool:

@@ -20,6 +20,8 @@ class RobotCalibration:
         max_speed_m_s: top forward speed.
         line_floor_m: what a line sensor reads over the bare floor (its height).
         body_radius_m: its chassis radius (None: unknown; it then passes no body).
+        line_spacing_m: lateral distance between neighbouring line sensors (None:
+            unknown; it then takes any strip it finds leaving a vertex for its lane).
     """
 
     wheel_radius_m: float
@@ -28,6 +30,7 @@ class RobotCalibration:
     max_speed_m_s: float
     line_floor_m: float = 0.02
     body_radius_m: float | None = None
+    line_spacing_m: float | None = None
 
 
 class Odometry:

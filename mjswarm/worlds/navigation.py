@@ -22,6 +22,7 @@ def calibration(geom: RobotGeometry) -> RobotCalibration:
         max_speed_m_s=geom.max_speed_m_s,
         line_floor_m=geom.line_sensor_height_m,
         body_radius_m=geom.body_radius_m,
+        line_spacing_m=geom.line_sensor_spacing_m,
     )
 
 
