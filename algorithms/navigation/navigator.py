@@ -354,8 +354,13 @@ class Navigator:
         A sensor's strip counts as the lane sought when that lane's line is the nearest
         of the vertex's lane lines (both lanes of every edge measured here, on the
         robot's side of the centre; positions by odometry from the centre it left). A
-        sensor on the lane sought is nearest it, noise-free or not, so runs whose sensors
-        find their own lane first keep their results. None without the sensor spacing."""
+        sensor on the lane sought lies within half a strip (15 mm) of its line, and the
+        nearest other lane line is about 4 cm away where that lane starts (edges 45 or 60
+        degrees apart; 7 cm at 90, and farther beyond the start), so the check errs only
+        when the robot's estimate of where the sensor is errs by 5-20 mm across the lane
+        (5 mm for a sensor on the strip's edge nearest the other line); noise-free runs
+        keep their results (main-job digest and stress grid unchanged). None without the
+        sensor spacing."""
         spacing = self.cal.line_spacing_m
         others = [a for a in self.edge_angles if abs(wrap(a - angle)) > MIN_EDGE_GAP / 2.0]
         if spacing is None or not others:
