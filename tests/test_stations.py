@@ -8,8 +8,8 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from algorithms.exploration.entry import (EntryGranted, EntryRequest, LeftVertex, TurnedBack,
-                                          VertexClear, Withdraw)
+from algorithms.exploration.entry import (EntryBusy, EntryGranted, EntryRequest, GiveUp,
+                                          LeftVertex, TurnedBack, VertexClear, Withdraw)
 from mjswarm.arena import incidence_angle, load_arena
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
 from mjswarm.experiments.stations import VertexStations
@@ -228,3 +228,36 @@ def test_a_withdrawn_clear_grant_is_taken_back():
     _granted(run, 0, u, w)
     run.stations._receive(0, Withdraw())
     assert run.stations.target[0] == u and run.stations.leaving[0] is None and run.stations.stations.holder == {u: 0}
+
+
+def test_a_robot_that_gives_up_a_waiting_request_is_told_busy_and_never_granted():
+    """Step 8: a request still waiting is dropped and answered ``EntryBusy`` with its
+    angle; the vertex, freed later, is not granted to it; the robot keeps its own."""
+    run, u, w = _on_fig9()
+    run.stations.target[:] = [u, w]
+    run.stations.stations.occupy(0, u)
+    run.stations.stations.occupy(1, w)  # w is held: robot 0's request waits
+    angle = _angle(run, u, w)
+    run.stations._receive(0, EntryRequest(angle))
+    run.stations.before_step(run.loop)
+    run.uplink.step()
+    assert run.uplink.receive_for(0) == []
+    run.stations._receive(0, GiveUp())
+    run.uplink.step()
+    assert [m.payload for m in run.uplink.receive_for(0)] == [EntryBusy(angle)]
+    assert run.stations.gave_up == 1
+    run.stations.stations.release(1, w)
+    run.stations.before_step(run.loop)
+    run.uplink.step()
+    assert run.uplink.receive_for(0) == [] and run.stations.stations.holder == {u: 0}
+
+
+def test_a_give_up_that_crosses_its_grant_leaves_the_grant_standing():
+    """A robot whose request was granted as it gave up gets no ``EntryBusy``: the grant
+    on its way stands and the robot obeys it (no grant is taken back half-way)."""
+    run, u, w = _on_fig9()
+    assert _granted(run, 0, u, w) == [EntryGranted(True, _angle(run, u, w))]
+    run.stations._receive(0, GiveUp())
+    run.uplink.step()
+    assert run.uplink.receive_for(0) == [] and run.stations.gave_up == 0
+    assert run.stations.target[0] == w and run.stations.stations.holder[w] == 0

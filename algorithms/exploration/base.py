@@ -153,6 +153,8 @@ class Strategy(ABC):
     #: stored before this visit, the common frame an embodied robot re-anchors its
     #: heading to; None when the robot has just dropped the beacon (its own angles).
     stored_angles: tuple[float, ...] | None = None
+    #: Whether :meth:`give_up` can plan round a busy edge.
+    replans: ClassVar[bool] = False
 
     def __init__(self, index: int, n_robots: int, rng: np.random.Generator | None = None):
         if n_robots < 1 or not 0 <= index < n_robots:
@@ -184,6 +186,14 @@ class Strategy(ABC):
         anew. Only ``incidence-dfs`` routes round closed vertices
         (:mod:`~algorithms.exploration.incidence_dfs`); every other strategy refuses here."""
         raise NotImplementedError(f"strategy {self.name} cannot explore round a closed vertex")
+
+    def give_up(self, angle: float) -> None:
+        """The robot gave up its place in a queue for the edge at incidence ``angle`` (rad,
+        the beacons' frame) from the vertex of the latest call, and did not leave
+        (:mod:`~algorithms.exploration.entry`, step 8). The world then calls
+        :meth:`on_vertex` again at that vertex with ``arrived_by`` None, and that call plans
+        without leaving by that edge. Only strategies with :attr:`replans` give up."""
+        raise NotImplementedError(f"strategy {self.name} cannot plan round a busy edge")
 
     @abstractmethod
     def map_edges(self) -> list[tuple[str, str]]:

@@ -66,6 +66,17 @@ and every message is counted with the radio's. The protocol, from the robot's si
    the edge blocked
    (:meth:`~algorithms.exploration.base.Strategy.block`) and decides anew.
 
+8. Giving up a place in a queue (ours, issue 29). Robots heading for one frontier queue
+   vertex by vertex for grants (each waits on a centre for the vertex whose holder
+   waits for the next), and a queue that reaches back to the root stops the launches. A
+   robot on a centre whose request has not been granted for ``GIVE_UP_S`` sends
+   :class:`GiveUp`. The station drops the request if it is still waiting and answers
+   :class:`EntryBusy` with the request's angle; a request already granted stands (the
+   grant is on its way and the robot obeys it), so no grant is ever taken back half-way.
+   On ``EntryBusy`` the robot asks its strategy to plan again without leaving by that
+   edge (:meth:`~algorithms.exploration.base.Strategy.give_up`) and asks for the way the
+   new plan takes; only strategies that can plan round an edge give up (the others wait).
+
 A station serves the beacon of its vertex only to the robot it granted (or launched
 there): a robot that arrives anywhere else finds no beacon and stops.
 """
@@ -76,6 +87,13 @@ from typing import NamedTuple
 
 #: The address of the vertex stations.
 STATION = "station"
+#: How long (s of simulated time) a robot waits on a centre for a grant before it gives
+#: up its place (step 8): twice the longest ordinary wait measured, so that it gives up
+#: in queues only. Waits from a centre to its grant, measured: the main job (arena2, 4
+#: robots) 0-26 s; a dense team (lattice:6x6, 8 robots, 0.15 m/s, seed 1) median 0, 99th
+#: percentile 50 s, longest 58 s; a queue (lattice:12x12, 120 robots, 0.15 m/s,
+#: kinematic, before this step) 53 waits over 60 s, 29 over 120 s, the longest 710 s.
+GIVE_UP_S = 120.0
 
 
 class EntryRequest(NamedTuple):
@@ -136,6 +154,18 @@ class PassGranted(NamedTuple):
 
 class PassDone(NamedTuple):
     """Robot → station: I am off the opposite lane; open it again."""
+
+
+class GiveUp(NamedTuple):
+    """Robot → station: I have waited ``GIVE_UP_S`` for my request; drop it unless it is
+    granted (step 8)."""
+
+
+class EntryBusy(NamedTuple):
+    """Station → robot: your request for the edge at ``angle_rad`` was still waiting and
+    is dropped (an answer to :class:`GiveUp`, step 8); you have not left."""
+
+    angle_rad: float
 
 
 class EntryBlocked(NamedTuple):

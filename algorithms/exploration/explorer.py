@@ -52,6 +52,10 @@ Choices beyond the paper (the loop functions in :mod:`mjswarm.experiments.explor
 * **Closed vertices**: an entry blocked on its centre (:class:`~algorithms.exploration.
   entry.EntryBlocked`) is told to the strategy (``Strategy.block``) and decided anew.
 * **Idle**: a strategy that answers IDLE is asked again after ``idle_wait_s``.
+* **Queues**: a request on a centre ungranted for ``GIVE_UP_S`` is given up (:class:`~
+  algorithms.exploration.entry.GiveUp`); once the station has dropped it
+  (:class:`~algorithms.exploration.entry.EntryBusy`) the strategy plans round that edge
+  (``Strategy.give_up``) and the robot asks for the new way.
 """
 
 from __future__ import annotations
@@ -74,10 +78,13 @@ from algorithms.exploration.relay import ConnectedExplorer
 from algorithms.exploration.tether import Tether
 from algorithms.exploration.entry import (
     STATION,
+    GIVE_UP_S,
     EntryBlocked,
+    EntryBusy,
     EntryDenied,
     EntryGranted,
     EntryRequest,
+    GiveUp,
     Halted,
     LeftVertex,
     PassDone,
@@ -197,6 +204,8 @@ class Explorer(Controller):
         self._idle_since: float | None = None
         self._departure: float | None = None  # angle of the edge it waits to take
         self._asked: EntryRequest | None = None  # its request, until it departs
+        self._asked_at_s = 0.0  # when it sent that request (s)
+        self._giving_up = False  # sent GiveUp for that request, no answer yet
         self._trips = 0  # relay missions it has set out on (rule 6)
         self._withdrawn = False  # gave a grant back: it holds (asks again once it may go)
         self._leaving = False  # holds the vertex it left until it is in its corridor
@@ -347,6 +356,9 @@ class Explorer(Controller):
             else:
                 self.rule.forget_bearings()
                 self._held_still_s = 0.0
+            if self._queued_too_long(observation.time_s):
+                self._giving_up = True
+                out.append(Message(GiveUp(), STATION))
             # a vertex area it gives up is one it never backs into (``_retrace``)
             if self._leaving and nav.in_corridor:  # clear of the vertex it left
                 out.append(Message(LeftVertex(), STATION))
@@ -375,6 +387,15 @@ class Explorer(Controller):
             factor = speed / self.cruise_m_s
             v, w = v * factor, w * factor
         return Command(v, w, messages=tuple(out))
+
+    def _queued_too_long(self, now_s: float) -> bool:
+        """Whether it gives up its place in a queue now (:mod:`~algorithms.exploration.
+        entry`, step 8): on a centre, its request ungranted for ``GIVE_UP_S``, its
+        strategy able to plan round the edge. A tethered robot does not: its waits belong
+        to its tether's rules."""
+        return (self._departure is not None and self._asked is not None
+                and not self._giving_up and self.connected is None and self.strategy.replans
+                and now_s - self._asked_at_s >= GIVE_UP_S)
 
     def _back_off(self) -> float:
         """Its speed (m/s, negative: backwards) while it waits at its wall's end for the
@@ -559,6 +580,7 @@ class Explorer(Controller):
                 self._depart()
             else:
                 self._asked = EntryRequest(decision.angle, cx is not None and cx.stops_part_way)
+                self._asked_at_s, self._giving_up = now_s, False
                 out.append(Message(self._asked, STATION))
         elif decision.action == "idle":
             self._idle_since = now_s
@@ -603,6 +625,12 @@ class Explorer(Controller):
             self._halt(payload.reason, out)
         elif isinstance(payload, EntryBlocked):
             self._blocked(payload, out, observation)
+        elif isinstance(payload, EntryBusy):
+            if self._asked is not None and payload.angle_rad == self._asked.angle_rad:
+                # it gave up its place: it plans anew where it stands, round that edge
+                self.strategy.give_up(payload.angle_rad)
+                self._departure, self._asked = None, None
+                self._vertex_call(observation.beacon, observation.time_s, False, out, back=True)
 
     def _blocked(self, payload: EntryBlocked, out: list[Message],
                  observation: Observation) -> None:

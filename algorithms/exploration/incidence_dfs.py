@@ -116,12 +116,13 @@ class FrontierExplorer(MapStrategy):
         if self.queue and not self._keep(before):
             self.queue.clear()
         if not self.queue:
-            selected = self.select()
-            if selected is None:  # cut off from the root, nothing open within reach
+            plan = self.plan()
+            if plan is None:  # cut off from the root, nothing open within reach
                 return CUT_OFF if self.matrix.reach_finished(self.here) else IDLE
+            selected, route = plan
             self.matrix = self.matrix.select(selected, self.letters)
             self._selectors = self.matrix.selectors(selected)
-            self.queue = [*self.matrix.route(self.here, selected[0]), selected]
+            self.queue = [*route, selected]
         end = self.queue.pop(0)
         return self.leave(record, end, self.queue[-1] if self.queue else end)
 
@@ -144,6 +145,12 @@ class FrontierExplorer(MapStrategy):
     def observe(self) -> None:
         """Hook run after the first step, before any decision."""
 
+    def plan(self) -> tuple[End, list[End]] | None:
+        """Algorithm 4's new decision: the selected edge and the shortest route over
+        ``Gc(Rk)`` to its known end (None: nothing open within reach)."""
+        selected = self.select()
+        return None if selected is None else (selected, self.matrix.route(self.here, selected[0]))
+
     @abstractmethod
     def select(self) -> End | None:
         """The edge to explore next; called only when the exploration is not complete.
@@ -165,11 +172,57 @@ class IncidenceDFS(FrontierExplorer):
     """The proposed strategy: priority (4) ``{Em(Rk), Eu(Rk), Eo(Rk)}``."""
 
     name = "incidence-dfs"
+    replans = True
 
     def __init__(self, index, n_robots, rng=None, reselect: str = "taken"):
         super().__init__(index, n_robots, rng, reselect)
         #: ``Em(Rk)``: my-unexplored ends, most preferred last.
         self.my_unexplored: list[End] = []
+        #: ends of the current vertex it gave up waiting for (``give_up``)
+        self._given_up: set[End] = set()
+
+    def on_vertex(
+        self, beacon: Beacon, angles: Sequence[float], arrived_by: float | None
+    ) -> Decision:
+        if arrived_by is not None or beacon.id != self.here:
+            self._given_up.clear()  # they were ends of the vertex it stood on
+        return super().on_vertex(beacon, angles, arrived_by)
+
+    def plan(self) -> tuple[End, list[End]] | None:
+        """Algorithm 4's decision; after :meth:`give_up`, made on a copy of the matrix in
+        which the ends given up are blocked (so that it neither selects them nor routes
+        through them), with ``Em(Rk)`` as it was (the copy's pops are undone: the ends are
+        busy, not closed). If that leaves nothing open within reach, it forgets what it
+        gave up and decides as before: it queues again."""
+        if not self._given_up:
+            return super().plan()
+        real, stack = self.matrix, list(self.my_unexplored)
+        for end in self._given_up:
+            self.matrix = self.matrix.block(end)
+        try:
+            plan = super().plan()
+        finally:
+            self.matrix, self.my_unexplored = real, stack
+        if plan is None:
+            self._given_up.clear()
+            return super().plan()
+        return plan
+
+    def give_up(self, angle: float) -> None:
+        """The robot waited too long for the vertex across the edge at ``angle`` (rad, the
+        beacons' frame) from the vertex of the latest call, and did not leave
+        (:mod:`~algorithms.exploration.entry`, step 8; ours, issue 29): it drops its queue
+        and, at the next call here, plans without leaving by that edge (nor by any other
+        it gave up here). Nothing is written into the matrix: the edge keeps its status
+        (out, if it selected it: the marks of an abandoned selection stay, as after a
+        "taken" re-selection), so Theorem 1's completion test is unchanged, and an edge
+        given up is still explored by whoever selects it later (this robot too, once it
+        has left this vertex). What it costs is liveness only: a robot may give up and
+        come back more than once."""
+        here = self.here
+        self._given_up.add((here, match_angle(normalize_angle(angle), self.matrix.angles(here))))
+        self.queue.clear()
+        self.forget_departure()
 
     def observe(self) -> None:
         """Eq. (3): ``Em(Rk) = Em(vj) + Em(Rk)``: push this vertex's unexplored edges."""

@@ -366,7 +366,8 @@ def _embodied_lines(result: dict) -> list[str]:
          f"({result['realtime_factor']:.1f}x real time)"),
         (f"collisions: {result['collisions']} robot-robot contact events; "
          f"speed changes (eq. 27): {result['speed_changes']}"),
-        f"vertex entry: {result['station_messages']} messages with the stations",
+        (f"vertex entry: {result['station_messages']} messages with the stations, "
+         f"{result['queue_give_ups']} places in a queue given up"),
     ]
     lines += [f"stopped: R{s['robot']} at {s['at_s']:.1f} s: {s['reason']}"
               for s in result["stopped_robots"]]

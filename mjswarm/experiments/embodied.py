@@ -127,6 +127,9 @@ class EmbodiedResult(ExplorationResult):
     #: vertex-entry messages between robots and stations, both ways
     #: (:mod:`algorithms.exploration.entry`)
     station_messages: int = 0
+    #: requests dropped because their robot gave up its place in a queue and planned
+    #: round that edge (:mod:`algorithms.exploration.entry`, step 8)
+    queue_give_ups: int = 0
     #: the connectivity constraint, and the ground truth on it: ticks (with a robot on the
     #: floor) in which some robot had no radio route to the base, or the radio graph with
     #: the base was not biconnected, and their shares

@@ -31,7 +31,9 @@ Choices it makes, beyond the paper:
   one robot at a time; the protocol is :mod:`algorithms.exploration.entry`, carried by
   the stations' link (:class:`~mjswarm.core.radio.Uplink`, one tick each way, counted in
   ``station_messages``), and the grants are :mod:`mjswarm.experiments.stations`' (which also
-  explains why no circular wait can form). ``--no-collision-avoidance`` turns this off
+  explains why no circular wait can form); a robot that waits too long in a queue for
+  a grant gives up its place and plans round that edge (step 8, counted in
+  ``queue_give_ups``). ``--no-collision-avoidance`` turns this off
   together with the speed rule.
 * **Robots that stop** (the explorer's reasons, or a fault) release every vertex they
   hold, stay where they are as obstacles (a vertex whose area the body still occupies
@@ -359,6 +361,7 @@ class EmbodiedExploration(LoopFunctions):
             radio_max_messages_per_robot=None if radio is None else max(radio.sent.values()),
             radio_belief_agreement=None if self.beliefs is None else self.beliefs.agreement,
             station_messages=self.uplink.sent_up + self.uplink.sent_down,
+            queue_give_ups=self.stations.gave_up,
             connectivity=self.config.connectivity,
             cut_ticks=0 if truth is None else truth.cut_ticks,
             fragile_ticks=0 if truth is None else truth.fragile_ticks,

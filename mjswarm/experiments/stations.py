@@ -71,7 +71,9 @@ lane that leads only into the closed vertex (so it blocks nobody). :attr:`Statio
 when (ground truth, for the result's unreachable edges).
 
 Grants go in the order of the requests (then robot index), so a waiting robot is served
-before later ones. Ground truth used here, as the paper's station had it: the arena's
+before later ones. A robot may give up its place (:class:`~algorithms.exploration.entry.
+GiveUp`, step 8 of the protocol): a request still waiting is dropped and answered with
+:class:`~algorithms.exploration.entry.EntryBusy`; one already granted stands. Ground truth used here, as the paper's station had it: the arena's
 edges at each vertex (:func:`mjswarm.arena.geometry.vertex_fans`).
 """
 
@@ -85,9 +87,11 @@ from scipy.spatial import cKDTree
 
 from algorithms.exploration.entry import (
     EntryBlocked,
+    EntryBusy,
     EntryDenied,
     EntryGranted,
     EntryRequest,
+    GiveUp,
     Halted,
     LeftVertex,
     PassDone,
@@ -263,6 +267,8 @@ class StationService(LoopFunctions):
         self.closed: dict[str, tuple[int, float]] = {}
         #: robots on their way to a vertex that closed, to be told once out of every area
         self.blocked_on_way: set[int] = set()
+        #: requests dropped because their robot gave up its place in a queue
+        self.gave_up = 0
         self.loop: Loop | None = None
         world.beacon_at = self.beacon_at
         world.power_listeners.append(self._switched_off)
@@ -335,6 +341,12 @@ class StationService(LoopFunctions):
             self._turned_back(i, payload.from_lane)
         elif isinstance(payload, Withdraw):
             self._withdraw(i)
+        elif isinstance(payload, GiveUp):
+            # still waiting: dropped and told; granted: the grant on its way stands
+            if i in self.stations.requests:
+                self.stations.withdraw(i)
+                self.uplink.reply(i, EntryBusy(self.asked[i]))
+                self.gave_up += 1
         elif isinstance(payload, LeftVertex):
             left, self.leaving[i] = self.leaving[i], None
             self.stations.release(i, left)
