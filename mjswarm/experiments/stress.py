@@ -231,6 +231,7 @@ def run_grid(runs: list[StressRun], workers: int, log=None,
                       f"map={result.map_correct} contacts={result.collisions} "
                       f"stopped={len(result.stopped_robots)} "
                       f"heading={result.heading_error_deg:.1f} "
+                      f"give_ups={result.queue_give_ups} sim={result.sim_time_s:.0f}s "
                       f"pass={passed(result, max_heading_error_deg)} wall={wall:.0f}s",
                       file=log, flush=True)
     return done
