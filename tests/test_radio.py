@@ -376,3 +376,19 @@ def test_removing_the_last_robot_leaves_an_empty_radio():
     radio.remove("a")
     radio.remove("b")
     assert radio.present == () and radio.graph().number_of_nodes() == 0
+
+
+def test_a_repeated_broadcast_is_checked_again_after_a_robot_leaves():
+    """``send_all`` reuses the messages of a heartbeat sent again by the same senders; a
+    robot removed in between is refused as on the first send, and counts stay per send."""
+    radio = Radio(["a", "b", "c"], range_m=1.0)
+    radio.move({"a": (0.0, 0.0), "b": (0.5, 0.0), "c": (0.9, 0.0)})
+    beat = ("beat",)
+    for _ in range(2):
+        radio.send_all(["a", "b", "c"], beat)
+        radio.step()
+    assert radio.sent == {"a": 2, "b": 2, "c": 2}
+    assert [m.sender for m in radio.receive("b")] == ["a", "c", "a", "c"]
+    radio.remove("c")
+    with pytest.raises(MjswarmError, match="not in the team"):
+        radio.send_all(["a", "b", "c"], beat)

@@ -148,11 +148,12 @@ class KinematicDrive:
         touching: set[tuple[int, int]] = set()
         centres = after
         while True:
-            pairs, deeper = self._robot_overlaps(before, centres)
+            tree = cKDTree(centres)  # one tree for both queries
+            pairs, deeper = self._robot_overlaps(before, centres, tree)
             touching.update(map(tuple, pairs[deeper].tolist()))
             anew = np.zeros(len(start), bool)
             anew[pairs[deeper].ravel()] = True
-            anew |= self._wall_overlaps(before, centres)
+            anew |= self._wall_overlaps(before, centres, tree)
             anew &= ~stopped
             if not anew.any():
                 break
@@ -161,11 +162,12 @@ class KinematicDrive:
         touching.update(map(tuple, pairs.tolist()))  # what still overlaps at the final poses
         return stopped, touching
 
-    def _robot_overlaps(self, before: np.ndarray, now: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Robot pairs ``(i, j)``, i < j, whose discs overlap now, and whether each
-        overlaps more than before the tick."""
+    def _robot_overlaps(self, before: np.ndarray, now: np.ndarray,
+                        tree: cKDTree) -> tuple[np.ndarray, np.ndarray]:
+        """Robot pairs ``(i, j)``, i < j, whose discs overlap now (``tree``: a k-d tree of
+        ``now``), and whether each overlaps more than before the tick."""
         reach = 2.0 * self.footprint_radius_m
-        pairs = cKDTree(now).query_pairs(reach, output_type="ndarray").reshape(-1, 2)
+        pairs = tree.query_pairs(reach, output_type="ndarray").reshape(-1, 2)
         pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
         gap_now = np.linalg.norm(now[pairs[:, 0]] - now[pairs[:, 1]], axis=1)
         gap_before = np.linalg.norm(before[pairs[:, 0]] - before[pairs[:, 1]], axis=1)
@@ -174,13 +176,14 @@ class KinematicDrive:
         deeper = depth_now > np.maximum(depth_before, 0.0) + OVERLAP_TOL_M
         return pairs[overlap], deeper[overlap]
 
-    def _wall_overlaps(self, before: np.ndarray, now: np.ndarray) -> np.ndarray:
-        """Robots whose disc overlaps a wall now more than before the tick."""
+    def _wall_overlaps(self, before: np.ndarray, now: np.ndarray, tree: cKDTree) -> np.ndarray:
+        """Robots whose disc overlaps a wall now more than before the tick (``tree``: a
+        k-d tree of ``now``)."""
         hit = np.zeros(len(now), bool)
         if self._walls is None:
             return hit
         centre, axes, half = self._walls
-        near = cKDTree(now).sparse_distance_matrix(self._pieces, self._piece_reach_m,
+        near = tree.sparse_distance_matrix(self._pieces, self._piece_reach_m,
                                                    output_type="ndarray")
         pair = np.unique(self._piece_wall[near["j"]] * len(now) + near["i"])
         wall, robot = np.divmod(pair, len(now))

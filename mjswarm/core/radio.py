@@ -198,7 +198,12 @@ class Radio:
         #: addressee index: -1 everybody who hears it, -2 nobody), or a team's broadcast
         #: (:meth:`send_all`): (its messages as a list, the table, the senders' indices, -1)
         self._outbox: list[tuple] = []
+        #: the last team broadcast (:meth:`send_all`): payload, the present robots then,
+        #: senders, messages and the senders' indices; immutable messages, reused while a
+        #: team sends the same payload object from the same senders (a heartbeat)
+        self._broadcast: tuple | None = None
         self._inbox: dict[Hashable, list[Message]] = {r: [] for r in self.robots}
+        self._filled: set[Hashable] = set()  # robots whose ``_inbox`` is not empty
         #: the last delivery, cut per robot when it asks: messages, message index of each
         #: copy sorted by recipient, each robot's slice of them, who has not asked yet
         self._batch: tuple[list, np.ndarray, list] | None = None
@@ -233,11 +238,14 @@ class Radio:
 
     def remove(self, robot: Hashable) -> None:
         """The robot leaves (crash or recall): no links, nothing more sent to or by it."""
-        self._present.pop(robot, None)
+        # a new dict, never changed in place (``restore`` too): a cached broadcast
+        # (:meth:`send_all`) knows the roster it was checked against by identity
+        self._present = {r: None for r in self._present if r != robot}
         self._on_air[self._index[robot]] = False
         self._outbox = [self._without(e, robot) if type(e[0]) is list else e
                         for e in self._outbox if type(e[0]) is list or e[0].sender != robot]
         self._inbox[robot].clear()
+        self._filled.discard(robot)
         self._unread[self._index[robot]] = False  # what it had not read is lost
         self._relink()
 
@@ -318,22 +326,30 @@ class Radio:
     def send_all(self, senders: Sequence[Hashable], payload: Any) -> None:
         """Every robot of ``senders`` broadcasts ``payload``: as :meth:`send` once per
         sender, in this order (a team's heartbeat), with one immutability check."""
-        check_immutable(payload)
-        present, sent, index, table = self._present, self.sent, self._index, self._table
+        present, sent = self._present, self.sent
+        cached = self._broadcast
+        if (cached is not None and cached[0] is payload and cached[1] is present
+                and cached[2] == senders):  # the heartbeat of the tick before: its messages
+            messages, rows = cached[3], cached[4]
+        else:
+            check_immutable(payload)
+            for sender in senders:
+                if sender not in present:
+                    raise MjswarmError(f"radio: robot {sender!r} is not in the team")
+            messages = list(map(Message._make, zip(repeat(payload), repeat(None), senders)))
+            rows = np.fromiter(map(self._index.__getitem__, senders), np.intp, len(senders))
+            rows.flags.writeable = False
+            self._broadcast = (payload, present, list(senders), messages, rows)
         for sender in senders:
-            if sender not in present:
-                raise MjswarmError(f"radio: robot {sender!r} is not in the team")
             sent[sender] += 1
-        messages = list(map(Message._make, zip(repeat(payload), repeat(None), senders)))
-        self._outbox.append((messages, table,
-                             np.fromiter(map(index.__getitem__, senders), np.intp, len(senders)), -1))
+        self._outbox.append((messages, self._table, rows, -1))
 
     def receive_all(self, robots: Sequence[Hashable]) -> tuple[list[Message], np.ndarray, np.ndarray]:
         """Drain the inboxes of ``robots`` at once, as :meth:`receive` for each in turn:
         the messages (each once), the index of each copy into them, robot by robot in
         delivery order, and each robot's bounds in those copies, shape (len(robots) + 1,)
         (:class:`~algorithms.batch.Readings`' inbox)."""
-        if any(self._inbox[r] for r in robots) or self._batch is None:  # leftovers: robot by robot
+        if self._batch is None or not self._filled.isdisjoint(robots):  # leftovers: one by one
             inboxes = [self.receive(r) for r in robots]
             messages = [m for inbox in inboxes for m in inbox]
             return (messages, np.arange(len(messages)),
@@ -353,6 +369,7 @@ class Radio:
         inbox = self._inbox[robot]
         if inbox:
             self._inbox[robot] = []
+            self._filled.discard(robot)
         else:
             inbox = []
         k = self._index[robot]
@@ -460,6 +477,7 @@ class Radio:
             for k in np.flatnonzero(self._unread).tolist():
                 self._unread[k] = False
                 messages, copies, bounds = self._batch
+                self._filled.add(self.robots[k])
                 self._inbox[self.robots[k]] += map(messages.__getitem__,
                                                    copies[bounds[k]:bounds[k + 1]].tolist())
         self._batch = None
