@@ -79,11 +79,16 @@ def test_a_held_lane_is_granted_to_nobody_and_closes_no_cycle():
     assert sorted(stations.grant()) == [(0, "v3"), (1, "v4")]
 
 
-def test_a_robot_passes_a_dead_one_and_the_team_completes_the_true_map():
+@pytest.mark.parametrize("dies_at_s", [90, 91])
+def test_a_robot_passes_a_dead_one_and_the_team_completes_the_true_map(dies_at_s):
     """``arena2``, 4 robots: R1 fails at 90 s at the start of its corridor from v3 to v4;
-    the robot sent along that edge next passes it (before passing, the run stalled)."""
+    the robot sent along that edge next passes it (before passing, the run stalled). At
+    91 s it stands 0.33 m along that 0.6 m edge, and the opposite lane ends 0.11 m past
+    it, before the passer is a body diameter past: the passer drives on and steps square
+    onto the centre line (``Navigator._lane_ended``); the diagonal shift had touched the
+    body (23 contact events)."""
     spec = load_arena("arena2")
-    config = EmbodiedConfig(faults=[parse_fault("robot:1@90")])
+    config = EmbodiedConfig(faults=[parse_fault(f"robot:1@{dies_at_s}")])
     run = EmbodiedExploration(spec, make_minds("incidence-dfs", 4, 0), config, 0)
     result = run.run()
     assert result.completed and result.map_correct, result.ended_because

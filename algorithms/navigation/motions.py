@@ -234,12 +234,18 @@ class FollowLineAlong:
         """Whether it stopped because it came ``distance_m`` along ``heading``."""
         return self.line.ended_at_m is None
 
+    def remaining_m(self, odo: Odometry) -> float:
+        """How much of ``distance_m`` (m) is still to come along ``heading``."""
+        return self.distance_m - self._along(odo)
+
     def step(self, odo: Odometry, percept: Percept):
-        along = ((odo.x - self.origin[0]) * math.cos(self.heading)
-                 + (odo.y - self.origin[1]) * math.sin(self.heading))
-        if along >= self.distance_m:
+        if self._along(odo) >= self.distance_m:
             return None
         return self.line.step(odo, percept)
+
+    def _along(self, odo: Odometry) -> float:
+        return ((odo.x - self.origin[0]) * math.cos(self.heading)
+                + (odo.y - self.origin[1]) * math.sin(self.heading))
 
 
 @dataclass
