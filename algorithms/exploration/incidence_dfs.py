@@ -104,10 +104,15 @@ class FrontierExplorer(MapStrategy):
         self.queue: list[End] = []
         #: Robots known to have selected the selected edge, this one included.
         self._selectors: frozenset[str] = frozenset()
+        #: ends of the vertex it stands on that it gave up waiting for (only strategies
+        #: that plan round them fill it: ``IncidenceDFS.give_up``)
+        self._given_up: set[End] = set()
 
     def on_vertex(
         self, beacon: Beacon, angles: Sequence[float], arrived_by: float | None
     ) -> Decision:
+        if self._given_up and (arrived_by is not None or beacon.id != self.here):
+            self._given_up.clear()  # ends of a vertex it has left
         record, before = self.first_step(beacon, angles, arrived_by)
         self.observe()
         if self.matrix.is_complete(self.here, self.root):
@@ -178,15 +183,6 @@ class IncidenceDFS(FrontierExplorer):
         super().__init__(index, n_robots, rng, reselect)
         #: ``Em(Rk)``: my-unexplored ends, most preferred last.
         self.my_unexplored: list[End] = []
-        #: ends of the current vertex it gave up waiting for (``give_up``)
-        self._given_up: set[End] = set()
-
-    def on_vertex(
-        self, beacon: Beacon, angles: Sequence[float], arrived_by: float | None
-    ) -> Decision:
-        if arrived_by is not None or beacon.id != self.here:
-            self._given_up.clear()  # they were ends of the vertex it stood on
-        return super().on_vertex(beacon, angles, arrived_by)
 
     def plan(self) -> tuple[End, list[End]] | None:
         """Algorithm 4's decision; after :meth:`give_up`, made on a copy of the matrix in
