@@ -398,7 +398,7 @@ class Navigator:
     def _shift(self, heading: float, side: int, distance_m: float | None = None,
                angle: float = SHIFT_ANGLE) -> list:
         """Sidestep ``distance_m`` (default ``lane_offset_m``) to the left (side=+1) or
-        right (-1) of ``heading``."""
+        right (-1) of ``heading``, driving at ``angle`` (rad) to it."""
         diagonal = heading + side * angle
         across = self.conv.lane_offset_m if distance_m is None else distance_m
         return [
