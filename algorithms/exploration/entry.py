@@ -89,10 +89,11 @@ from typing import NamedTuple
 STATION = "station"
 #: How long (s of simulated time) a robot waits on a centre for a grant before it gives
 #: up its place (step 8): twice the longest wait measured in a run without a long queue.
-#: Waits from a centre to its grant, measured before this step: the main job (arena2, 4
-#: robots) 0-26 s; a dense team (lattice:6x6, 8 robots, 0.15 m/s, seed 1) median 0, 99th
-#: percentile 50 s, longest 58 s; a queue (lattice:12x12, 120 robots, 0.15 m/s,
-#: kinematic) 53 waits over 60 s, 29 over 120 s, the longest 710 s. Queues form in small
+#: Waits from a centre to its grant (``python benchmarks/grant_waits.py EXPLORE-ARGS``):
+#: the main job (arena2, 4 robots) 0-26 s; a dense team (lattice:6x6, 8 robots, 0.15 m/s,
+#: seed 1) median 0, 99th percentile 44 s, longest 58 s; a queue (lattice:12x12, 120
+#: robots, 0.15 m/s, kinematic, on the code before this step, f1baf58) 53 waits over
+#: 60 s, 29 over 120 s, the longest 710 s. Queues form in small
 #: teams too, behind a hub: 23 of the stress grid's 100 runs give up 46 places in all
 #: (wheel:8 in 8 of its 12), and every run still passes (README, issue 29).
 GIVE_UP_S = 120.0
