@@ -184,7 +184,7 @@ class KinematicDrive:
             return hit
         centre, axes, half = self._walls
         near = tree.sparse_distance_matrix(self._pieces, self._piece_reach_m,
-                                                   output_type="ndarray")
+                                           output_type="ndarray")
         pair = np.unique(self._piece_wall[near["j"]] * len(now) + near["i"])
         wall, robot = np.divmod(pair, len(now))
         depth_now = self._wall_depth(now[robot], centre[wall], axes[wall], half[wall])
