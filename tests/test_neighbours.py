@@ -36,6 +36,23 @@ def test_pairs_equal_the_exact_rule_and_survive_other_askers(seed):
         assert shared.pairs(other, range_m).tolist() == Neighbours().pairs(other, range_m).tolist()
 
 
+@pytest.mark.parametrize("seed", range(24))
+def test_every_pair_and_the_tree_propose_the_same_pairs(monkeypatch, seed):
+    """Below ``TREE_FROM_ROBOTS`` every pair is a candidate, from it the k-d tree's: both
+    ways give the same pairs in the same order, at random ranges and on lattices with pairs
+    exactly at the range (teams of 2-200)."""
+    from mjswarm.core import neighbours
+
+    _, positions, range_m = random_team(seed)
+    xy = np.array([p for p in positions.values() if np.isfinite(p).all()])
+    answers = []
+    for tree_from in (0, 10**9):
+        monkeypatch.setattr(neighbours, "TREE_FROM_ROBOTS", tree_from)
+        answers.append([Neighbours().pairs(xy, r).tolist() for r in (range_m, range_m * 0.37)])
+    assert answers[0] == answers[1]
+    assert answers[0][0]  # each of these teams holds pairs within its range: not vacuous
+
+
 def separate_bearings(sim, fov_rad: float, range_m: float) -> tuple[np.ndarray, ...]:
     """The bearing sensor with a k-d tree and line of sight of its own, every pair's
     bearing wrapped in full (the sensor before the shared search)."""

@@ -179,6 +179,9 @@ class FollowLine:
     _holding: tuple[bool, bool] | None = None
     _end: CentreEnd = field(default_factory=CentreEnd)
     _sampled_m: float = -math.inf  # the odometry distance of the last heading kept
+    #: sums of the sines and cosines of all ``headings``, added in order as they are kept
+    _sin_sum: float = 0.0
+    _cos_sum: float = 0.0
 
     def step(self, odo: Odometry, percept: Percept):
         left, centre, right = percept.line
@@ -201,6 +204,8 @@ class FollowLine:
             self._position = side / 2.0 if centre else side
             if self._position == 0.0 and odo.distance_m - self._sampled_m >= HEADING_SAMPLE_M:
                 self.headings.append(odo.theta)
+                self._sin_sum += math.sin(odo.theta)
+                self._cos_sum += math.cos(odo.theta)
                 self._sampled_m = odo.distance_m
         else:
             if self.ended_at_m is None:
@@ -211,10 +216,14 @@ class FollowLine:
 
     def direction(self, fallback: float, last: int | None = 40) -> float:
         """Mean heading (rad) over the last ``last`` aligned ticks (all if None), or
-        ``fallback`` when there were none."""
-        recent = self.headings[-last:] if last else self.headings
-        if not recent:
+        ``fallback`` when there were none. Over all of them it reads the running sums
+        (the same additions in the same order as summing the list: asked every tick on a
+        lane, by :meth:`~.navigator.Navigator.lane_bearings`)."""
+        if not self.headings:
             return fallback
+        if not last or last >= len(self.headings):
+            return math.atan2(self._sin_sum, self._cos_sum)
+        recent = self.headings[-last:]
         return math.atan2(sum(math.sin(h) for h in recent), sum(math.cos(h) for h in recent))
 
 

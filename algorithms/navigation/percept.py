@@ -144,8 +144,7 @@ class LineFilter:
             self.window = min(LINE_WINDOW_MAX, 2 * math.ceil((needed - 1.0) / 2.0) + 1)
         n = min(self.window, len(self._readings[0]))
         for i, readings in enumerate(self._readings):
-            recent = list(readings)[-n:]
-            mean = math.fsum(recent) / len(recent)
+            mean = readings[-1] if n == 1 else math.fsum(list(readings)[-n:]) / n
             self._on[i] = self.floor_m - mean > LINE_THRESHOLD_M
             if not self._on[i] and abs(mean - self.floor_m) < LINE_THRESHOLD_M / 2.0:
                 self.floor_m += FLOOR_RATE * (mean - self.floor_m)

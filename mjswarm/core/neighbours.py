@@ -8,6 +8,10 @@ positions ``xy`` (metres, one row per robot) and a range ``r`` (metres): every p
 sorted by ``k``, then ``l``. A k-d tree (``scipy.spatial.cKDTree.query_pairs``, itself
 inclusive) proposes the pairs within ``r`` enlarged by ``CANDIDATE_SLACK`` relative and the
 exact test decides, so the tree's own rounding cannot add or lose a pair at exactly ``r``.
+Below ``TREE_FROM_ROBOTS`` robots every pair is a candidate instead (the same exact test,
+the pairs in the same order): for the main job's 4 robots that costs 5 us a search where
+the tree costs 17 us (``python benchmarks/neighbours_bench.py``: the two meet between 128
+and 256 robots).
 
 The tree is built once per distinct positions (compared by their bytes: about 2 us for 1000
 robots, where building the tree takes about 55 us and querying it 110 us; midpoint splits
@@ -23,6 +27,8 @@ from scipy.spatial import cKDTree
 
 #: relative enlargement of the k-d tree's search radius over the range (the exact test decides)
 CANDIDATE_SLACK = 1e-9
+#: From this many robots the k-d tree proposes the candidate pairs; below it, every pair.
+TREE_FROM_ROBOTS = 128
 
 
 class Neighbours:
@@ -33,6 +39,7 @@ class Neighbours:
         self._columns = np.empty((0, 0))  # their coordinates, one row per axis
         self._tree: cKDTree | None = None
         self._answers: dict[float, np.ndarray] = {}  # range (m) -> its pairs at ``_key``
+        self._every: tuple[int, np.ndarray, np.ndarray] = (0, *np.triu_indices(0, 1))
 
     def pairs(self, xy: np.ndarray, range_m: float) -> np.ndarray:
         """Every pair ``(k, l)``, ``k < l``, of rows of ``xy`` (finite, metres) at most
@@ -48,16 +55,22 @@ class Neighbours:
         return found
 
     def _search(self, range_m: float) -> np.ndarray:
-        """:meth:`pairs` at the remembered positions: the tree's candidates in key order,
-        then the exact test (coordinates summed in order, as ``sum(axis=-1)`` does)."""
+        """:meth:`pairs` at the remembered positions: the candidates in key order (every
+        pair, or the tree's), then the exact test (coordinates summed in order, as
+        ``sum(axis=-1)`` does)."""
         columns = self._columns
         n = columns.shape[1]
         if n < 2:
             return np.empty((0, 2), np.int64)
-        if self._tree is None:
-            self._tree = cKDTree(columns.T, balanced_tree=False, compact_nodes=False)
-        near = self._tree.query_pairs(range_m * (1.0 + CANDIDATE_SLACK), output_type="ndarray")
-        k, l = np.divmod(np.sort(near[:, 0] * n + near[:, 1]), n)
+        if n < TREE_FROM_ROBOTS:
+            if self._every[0] != n:
+                self._every = (n, *np.triu_indices(n, 1))
+            _, k, l = self._every
+        else:
+            if self._tree is None:
+                self._tree = cKDTree(columns.T, balanced_tree=False, compact_nodes=False)
+            near = self._tree.query_pairs(range_m * (1.0 + CANDIDATE_SLACK), output_type="ndarray")
+            k, l = np.divmod(np.sort(near[:, 0] * n + near[:, 1]), n)
         gap = (columns[0][k] - columns[0][l]) ** 2
         for column in columns[1:]:
             gap += (column[k] - column[l]) ** 2
