@@ -79,14 +79,17 @@ def test_a_held_lane_is_granted_to_nobody_and_closes_no_cycle():
     assert sorted(stations.grant()) == [(0, "v3"), (1, "v4")]
 
 
-@pytest.mark.parametrize("dies_at_s", [90, 91])
+@pytest.mark.parametrize("dies_at_s", [25.6, 90, 91])
 def test_a_robot_passes_a_dead_one_and_the_team_completes_the_true_map(dies_at_s):
     """``arena2``, 4 robots: R1 fails at 90 s at the start of its corridor from v3 to v4;
     the robot sent along that edge next passes it (before passing, the run stalled). At
     91 s it stands 0.33 m along that 0.6 m edge, and the opposite lane ends 0.11 m past
-    it, before the passer is a body diameter past: the passer drives on and steps square
-    onto the centre line (``Navigator._lane_ended``); the diagonal shift had touched the
-    body (23 contact events)."""
+    it, before the passer is clear of it: the passer drives on and steps square onto the
+    centre line (``Navigator._lane_ended``); the diagonal shift had touched the body (23
+    contact events). At 25.6 s it stands on the first edge, 0.255 m from ``v2``'s centre
+    (just beyond the radius that closes the vertex): stepping across a diameter and a
+    margin past it left the passer's centre sensor beyond the incoming spoke, and it
+    stopped 15 cm off ``v2`` (``Navigator._square_clearance_m``)."""
     spec = load_arena("arena2")
     config = EmbodiedConfig(faults=[parse_fault(f"robot:1@{dies_at_s}")])
     run = EmbodiedExploration(spec, make_minds("incidence-dfs", 4, 0), config, 0)

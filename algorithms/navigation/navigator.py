@@ -70,7 +70,7 @@ from algorithms.navigation.percept import LineFilter, Percept, WallWatch
 
 SHIFT_ANGLE = math.radians(60.0)
 #: Room (m) beyond touching that a pass leaves between the robot and the body it passed
-#: before it steps toward the body's side again, when its lane ends early (``_lane_ended``).
+#: when it steps onto the centre line, its lane having ended early (``_lane_ended``).
 PASS_MARGIN_M = 0.02
 #: The least angle (rad) between two edges of a vertex the arena marks allow.
 MIN_EDGE_GAP = math.radians(45.0)
@@ -442,8 +442,24 @@ class Navigator:
         self.events.append(NavigatorEvent(NavEvent.PASSED))
         if follow.reached:  # on to the opposite lane's end
             self._plan = deque([(follow.line, self._lane_ended)])
-        else:  # the lane ended less than a diameter past the body: on, then across
-            self._lane_ended(follow.line, follow.remaining_m(self.odometry) + PASS_MARGIN_M)
+        else:  # the lane ended before it was a diameter past the body: on, then across
+            short_m = 2.0 * self.cal.body_radius_m - self._square_clearance_m
+            self._lane_ended(follow.line, follow.remaining_m(self.odometry) - short_m)
+
+    @property
+    def _square_clearance_m(self) -> float:
+        """How far past a passed body's centre (m, along the lane) the robot's centre must
+        be to step square from the opposite lane onto the centre line, ``lane_offset_m``
+        beside the body on its lane, and stay ``PASS_MARGIN_M`` clear of touching it:
+        ``sqrt((2 r + margin)^2 - offset^2)``, 0.144 m for the Spark V (a diameter and the
+        margin straight along would be 0.17 m). The 2.6 cm matter: the station closes a
+        vertex for a body within ``VERTEX_CLEAR_RADIUS_M`` (0.255 m) of its centre, and a
+        body just beyond it left a robot stepping across at 0.17 m past it with its centre
+        sensor beyond the incoming spoke's inner end; its seek found the spoke on the far
+        side of the centre and it stood 15 cm off the vertex (``arena2``, 4 robots, seed
+        0, ``robot:1@25.6``: the second robot stopped, the map was lost)."""
+        reach_m = 2.0 * self.cal.body_radius_m + PASS_MARGIN_M
+        return math.sqrt(reach_m**2 - self.conv.lane_offset_m**2)
 
     def _rejoined(self, seek: SeekLine) -> None:
         if seek.failed:
@@ -482,10 +498,11 @@ class Navigator:
 
     def _lane_ended(self, lane: FollowLine, clear_m: float = 0.0) -> None:
         """The lane ended: arrive (module docstring). ``clear_m`` > 0 (m): it passed a
-        body on the opposite lane, and the lane ended before it was a body diameter past
-        the body; it drives that far on first, and steps onto the centre line square to
-        the lane, since the diagonal shift's turn toward the body's side would touch it
-        (``arena2`` with 4 robots, seed 0, ``robot:1@91``: 23 contact events before)."""
+        body on the opposite lane, and the lane ended before it was clear of the body
+        (:attr:`_square_clearance_m`); it drives that far on first, and steps onto the
+        centre line square to the lane, since the diagonal shift's turn toward the body's
+        side would touch it (``arena2`` with 4 robots, seed 0, ``robot:1@91``: 23 contact
+        events before)."""
         if not self.vertex_detected and not self._returning:
             self._lose("lane ended with the wall still beside the robot" if self._wall_seen
                        else "lane ended before any corridor wall was seen (not its lane?)")
