@@ -12,9 +12,11 @@ import pytest
 from algorithms.collision import CollisionRule
 from algorithms.exploration.entry import STATION, PassRequest
 from algorithms.exploration.explorer import PASS_AFTER_S, PASS_STEADY_M, Explorer
-from algorithms.navigation import NavEvent, NavigatorState
+from algorithms.navigation import NavEvent, Navigator, NavigatorState
+from algorithms.navigation.navigator import PASS_MARGIN_M
 from algorithms.robot import Detection, Observation
 from mjswarm.arena import load_arena
+from mjswarm.arena.geometry import LANE_OFFSET_M, SPOKE_INNER_RADIUS_M, VERTEX_CLEAR_RADIUS_M
 from mjswarm.core.simulation import Simulation
 from mjswarm.core.world import Pose2D, world_spec
 from mjswarm.experiments.embodied import EmbodiedConfig
@@ -77,6 +79,24 @@ def test_a_held_lane_is_granted_to_nobody_and_closes_no_cycle():
     assert stations.grant() == []  # ... but one of its lanes is held
     stations.passes.pop(9)
     assert sorted(stations.grant()) == [(0, "v3"), (1, "v4")]
+
+
+def test_a_pass_next_to_a_vertex_steps_across_with_its_sensor_on_the_incoming_spoke():
+    """The nearest a body on its lane can stand to a vertex that stays open is
+    ``VERTEX_CLEAR_RADIUS_M`` from its centre (nearer, the station closes the vertex). A
+    robot that passes it on the opposite lane and steps square onto the centre line there
+    (``Navigator._square_clearance_m`` past the body) keeps ``PASS_MARGIN_M`` from the
+    body and still has its centre sensor at least a centimetre outside the incoming
+    spoke's inner end, so that it finds and follows that spoke to the centre (stepping
+    across a diameter and the margin past the body left it 1.1 cm inside the inner end)."""
+    geometry = Simulation(world_spec([Pose2D(0.0, 0.0)])).geometry
+    nav = Navigator(calibration(geometry), conventions(geometry), 0.0, 0.1)
+    r, offset = geometry.body_radius_m, LANE_OFFSET_M
+    body_along_m = math.sqrt(VERTEX_CLEAR_RADIUS_M**2 - offset**2)  # from the vertex centre
+    robot_along_m = body_along_m - nav._square_clearance_m
+    assert math.hypot(nav._square_clearance_m, offset) >= 2.0 * r + PASS_MARGIN_M - 1e-12
+    sensor_m = robot_along_m - geometry.line_sensor_ahead_m
+    assert sensor_m >= SPOKE_INNER_RADIUS_M + 0.01, sensor_m
 
 
 @pytest.mark.parametrize("dies_at_s", [25.6, 90, 91])
