@@ -209,7 +209,7 @@ class EmbodiedExploration(LoopFunctions):
         """One :class:`Explorer` per mind (a docked robot's never steps)."""
         config, sim, world = self.config, self.sim, self.world
         tied = config.connectivity != "none"
-        cal, conv = calibration(sim.geometry), conventions(sim.geometry)
+        cal, conv = calibration(sim.geometry, sim.physics), conventions(sim.geometry)
         eps = config.epsilons or epsilons(len(self.minds))
         ticks = tether_unit_ticks(self.spec, config, sim.control_dt_s)
         need, first = NEED.get(config.connectivity, 1), next(iter(world.docked), None)

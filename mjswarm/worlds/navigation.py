@@ -13,8 +13,16 @@ from mjswarm.arena import geometry
 from mjswarm.core.robot import RobotGeometry
 
 
-def calibration(geom: RobotGeometry) -> RobotCalibration:
-    """The robot's knowledge of its own body, from its model."""
+#: How much a Spark V's odometry over-reads a turn in place with exact encoders, by
+#: physics tier: the dynamic tier's wheels scrub the floor (noise-free scans measured
+#: 1.0163-1.0172 on ``arena2`` at 0.05 and 0.2 m/s), the kinematic tier's roll exactly
+#: (``python benchmarks/turn_over_read.py``).
+TURN_OVER_READ = {"dynamic": 1.0167, "kinematic": 1.0}
+
+
+def calibration(geom: RobotGeometry, physics: str = "dynamic") -> RobotCalibration:
+    """The robot's knowledge of its own body, from its model, calibrated on the floor of
+    the ``physics`` tier."""
     return RobotCalibration(
         wheel_radius_m=geom.wheel_radius_m,
         track_m=geom.track_m,
@@ -23,6 +31,7 @@ def calibration(geom: RobotGeometry) -> RobotCalibration:
         line_floor_m=geom.line_sensor_height_m,
         body_radius_m=geom.body_radius_m,
         line_spacing_m=geom.line_sensor_spacing_m,
+        turn_over_read=TURN_OVER_READ[physics],
     )
 
 
