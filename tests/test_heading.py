@@ -75,7 +75,7 @@ def _slipping_odometry(seed: int, slip: float, ticks: int, left: float, right: f
     rng = np.random.default_rng(seed)
     odometry = Odometry(RobotCalibration(0.02, 0.1, 0.05, 0.2))
     if effective_track_m is not None:
-        odometry.calibrate(effective_track_m)
+        odometry.calibrate(effective_track_m, 1)
     read = np.zeros(2)
     odometry.update(tuple(read))
     for _ in range(ticks):
@@ -103,16 +103,21 @@ def test_a_scans_over_read_calibrates_the_distance_of_a_slipping_robot(seed):
     assert scaled.track_m == track_m * over_read
 
 
-def test_a_scans_over_read_within_the_floors_scrub_leaves_the_distance_alone():
-    """Below ``MIN_DISTANCE_OVER_READ`` beyond the floor's scrub the scale stays exactly 1
-    (noise-free runs keep their trajectories); beyond it, the scale is the over-read."""
-    from algorithms.navigation.odometry import MIN_DISTANCE_OVER_READ, Odometry, RobotCalibration
+@pytest.mark.parametrize("scans", [1, 4, 25])
+def test_a_scans_over_read_within_its_spread_leaves_the_distance_alone(scans):
+    """Beyond the floor's scrub, a mean over-read of ``scans`` scans within
+    ``OVER_READ_SIGMAS`` standard errors of none leaves the scale exactly 1 (noise-free and
+    line-noise runs keep their trajectories); beyond it, the scale is the over-read; no
+    slip model under-reads."""
+    from algorithms.navigation.odometry import (
+        OVER_READ_SIGMAS, SCAN_OVER_READ_SPREAD, Odometry, RobotCalibration)
 
     scrub = 1.0167
     odometry = Odometry(RobotCalibration(0.02, 0.1, 0.05, 0.2, turn_over_read=scrub))
-    odometry.calibrate(0.1 * scrub * (1.0 + 0.9 * MIN_DISTANCE_OVER_READ))
+    significant = OVER_READ_SIGMAS * SCAN_OVER_READ_SPREAD / math.sqrt(scans)
+    odometry.calibrate(0.1 * scrub * (1.0 + 0.99 * significant), scans)
     assert odometry.distance_scale == 1.0
-    odometry.calibrate(0.1 * scrub * 1.02)
-    assert odometry.distance_scale == pytest.approx(1.02, rel=1e-12)
-    odometry.calibrate(0.1 * scrub * 0.99)  # no slip model under-reads
+    odometry.calibrate(0.1 * scrub * (1.0 + 1.01 * significant), scans)
+    assert odometry.distance_scale == pytest.approx(1.0 + 1.01 * significant, rel=1e-12)
+    odometry.calibrate(0.1 * scrub * 0.99, scans)
     assert odometry.distance_scale == 1.0

@@ -8,10 +8,17 @@ from dataclasses import dataclass
 
 from algorithms.navigation.percept import LINE_WINDOW_MAX
 
-#: The least over-read of distance (a fraction) :meth:`Odometry.calibrate` corrects: ten
-#: times the spread of noise-free scans' estimate (0.05 %), and half the mean over-read of
-#: the smallest wheel slip the noise grid runs (0.8 % at ``--wheel-slip 0.01``).
-MIN_DISTANCE_OVER_READ = 0.005
+#: The spread (a fraction, one standard deviation) of one scan's over-read of a turn
+#: without slip: a scan times its full turn by the first spoke's two crossings, each placed
+#: to half a control tick (0.15 % of a turn at 1 rad/s and 50 Hz) and jittered by the line
+#: filter; with 0.5 mm of line noise single scans spread 0.25 % (-0.7 to +0.7 %), without it
+#: 0.05 % (``python benchmarks/turn_over_read.py``; ``--line-noise`` runs of the sample).
+SCAN_OVER_READ_SPREAD = 0.003
+#: How many standard errors of the scans' mean over-read must lie above none before
+#: :meth:`Odometry.calibrate` corrects the distance: 1.5 % after one scan, 0.75 % after
+#: four; the mean over-read of slip 0.02 (1.6 %) is corrected from the first scan, that
+#: of 0.01 (0.8 %) from the fourth.
+OVER_READ_SIGMAS = 5.0
 
 
 @dataclass(frozen=True)
@@ -85,21 +92,22 @@ class Odometry:
         self.distance_m += ds
         self._past.append(self.distance_m)
 
-    def calibrate(self, track_m: float) -> None:
-        """Take ``track_m`` (m), the effective track its scans found, and the distance
-        scale that goes with it (ours, issue 27). Encoders that over-read their wheels'
-        turn by a fraction ``e`` (wheel slip: the wheel spun more than it rolled) over-read
-        a turn in place and a straight drive alike, by ``e`` on average: the turn by
-        ``r (|dl| + |dr|) / b``, the drive by ``r (dl + dr) / 2``, both linear in the
-        wheels' readings. A scan is a whole turn (about 300 control ticks), so its
-        over-read beyond the floor's scrub (``turn_over_read``) measures ``e`` to about a
-        tenth of a per cent, and the distance is divided by ``1 + e``. Below
-        ``MIN_DISTANCE_OVER_READ`` the scale stays 1: noise-free scans find the scrub to
-        within 0.05 % (``python benchmarks/turn_over_read.py``), and noise-free runs keep
-        their trajectories to the bit."""
+    def calibrate(self, track_m: float, scans: int) -> None:
+        """Take ``track_m`` (m), the effective track found by the mean of ``scans``
+        scans, and the distance scale that goes with it (ours, issue 27). Encoders that
+        over-read their wheels' turn by a fraction ``e`` (wheel slip: the wheel spun more
+        than it rolled) over-read a turn in place and a straight drive alike, by ``e`` on
+        average: the turn by ``r (|dl| + |dr|) / b``, the drive by ``r (dl + dr) / 2``,
+        both linear in the wheels' readings, and a scan's whole turn (about 300 control
+        ticks) averages ``e`` to about a tenth of a per cent. So the scans' mean over-read
+        beyond the floor's scrub (``turn_over_read``) divides the distance, once it lies
+        ``OVER_READ_SIGMAS`` standard errors (``SCAN_OVER_READ_SPREAD / sqrt(scans)``)
+        above none; till then the scale stays 1, so that noise-free and line-noise runs
+        keep their trajectories to the bit."""
         self.track_m = track_m
         over_read = track_m / (self.cal.track_m * self.cal.turn_over_read)
-        self.distance_scale = over_read if over_read - 1.0 >= MIN_DISTANCE_OVER_READ else 1.0
+        significant = OVER_READ_SIGMAS * SCAN_OVER_READ_SPREAD / math.sqrt(scans)
+        self.distance_scale = over_read if over_read - 1.0 >= significant else 1.0
 
     def distance_back(self, ticks: int) -> float:
         """``distance_m`` as it was ``ticks`` updates ago (0: now; a filtered percept's
