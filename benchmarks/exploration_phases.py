@@ -13,7 +13,6 @@ and with ``mj_step``, not with ``benchmarks/exploration_bench.py``.
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from collections import Counter
@@ -24,6 +23,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 import mujoco  # noqa: E402
 
+from benchmarks.exploration_bench import main_job_arguments  # noqa: E402
 from mjswarm.arena import load_arena  # noqa: E402
 from mjswarm.core import simulation  # noqa: E402
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration  # noqa: E402
@@ -69,11 +69,7 @@ def phases(arena: str, robots: int, speed_m_s: float) -> tuple[Counter, int, flo
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--arena", default="arena2")
-    parser.add_argument("--robots", type=int, default=4)
-    parser.add_argument("--speed", type=float, default=0.05, help="m/s (default 0.05)")
-    args = parser.parse_args()
+    args = main_job_arguments(__doc__)
     spent, ticks, wall_s = phases(args.arena, args.robots, args.speed)
     print(f"{args.arena}, {args.robots} robots: {ticks} control ticks, "
           f"{wall_s / ticks * 1e6:.0f} us a tick in all")
