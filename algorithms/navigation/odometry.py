@@ -11,8 +11,8 @@ from algorithms.navigation.percept import LINE_WINDOW_MAX
 #: The spread (a fraction, one standard deviation) of one scan's over-read of a turn
 #: without slip: a scan times its full turn by the first spoke's two crossings, each placed
 #: to half a control tick (0.15 % of a turn at 1 rad/s and 50 Hz) and jittered by the line
-#: filter; with 0.5 mm of line noise single scans spread 0.25 % (-0.7 to +0.7 %), without it
-#: 0.05 % (``python benchmarks/turn_over_read.py``; ``--line-noise`` runs of the sample).
+#: filter; with 0.5 mm of line noise single scans spread 0.27 % (165 scans, -0.64 to +0.75
+#: %), without it about 0.05 % (``python benchmarks/turn_over_read.py``).
 SCAN_OVER_READ_SPREAD = 0.003
 #: How many standard errors of the scans' mean over-read must lie above none before
 #: :meth:`Odometry.calibrate` corrects the distance: 1.5 % after one scan, 0.75 % after
