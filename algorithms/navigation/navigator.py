@@ -442,7 +442,7 @@ class Navigator:
         self.events.append(NavigatorEvent(NavEvent.PASSED))
         if follow.reached:  # on to the opposite lane's end
             self._plan = deque([(follow.line, self._lane_ended)])
-        else:  # the lane ended before it was a diameter past the body: on, then across
+        else:  # the lane ended before it was clear of the body: on, then square across
             short_m = 2.0 * self.cal.body_radius_m - self._square_clearance_m
             self._lane_ended(follow.line, follow.remaining_m(self.odometry) - short_m)
 
