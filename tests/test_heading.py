@@ -75,7 +75,7 @@ def _slipping_odometry(seed: int, slip: float, ticks: int, left: float, right: f
     rng = np.random.default_rng(seed)
     odometry = Odometry(RobotCalibration(0.02, 0.1, 0.05, 0.2))
     if effective_track_m is not None:
-        odometry.calibrate(effective_track_m, 1)
+        odometry.calibrate(effective_track_m, 1, exact_crossings=True)
     read = np.zeros(2)
     odometry.update(tuple(read))
     for _ in range(ticks):
@@ -115,9 +115,25 @@ def test_a_scans_over_read_within_its_spread_leaves_the_distance_alone(scans):
     scrub = 1.0167
     odometry = Odometry(RobotCalibration(0.02, 0.1, 0.05, 0.2, turn_over_read=scrub))
     significant = OVER_READ_SIGMAS * SCAN_OVER_READ_SPREAD / math.sqrt(scans)
-    odometry.calibrate(0.1 * scrub * (1.0 + 0.99 * significant), scans)
+    odometry.calibrate(0.1 * scrub * (1.0 + 0.99 * significant), scans, exact_crossings=True)
     assert odometry.distance_scale == 1.0
-    odometry.calibrate(0.1 * scrub * (1.0 + 1.01 * significant), scans)
+    odometry.calibrate(0.1 * scrub * (1.0 + 1.01 * significant), scans, exact_crossings=True)
     assert odometry.distance_scale == pytest.approx(1.0 + 1.01 * significant, rel=1e-12)
-    odometry.calibrate(0.1 * scrub * 0.99, scans)
+    odometry.calibrate(0.1 * scrub * 0.99, scans, exact_crossings=True)
     assert odometry.distance_scale == 1.0
+
+
+def test_noisy_scans_never_take_a_track_below_the_floors():
+    """With noisy line readings a scan's own over-read spreads 0.3 %, and encoders never
+    under-read: a mean of the scans below the floor's scrub gives the floor's track
+    (``track_m * turn_over_read``, exactly), one above it that mean; with exact crossings
+    the track is always the scans' mean (noise-free runs keep their trajectories)."""
+    from algorithms.navigation.odometry import Odometry, RobotCalibration
+
+    scrub = 1.0167
+    odometry = Odometry(RobotCalibration(0.02, 0.1, 0.05, 0.2, turn_over_read=scrub))
+    for over_read in (0.994, 0.9999, 1.0, 1.0001, 1.006):
+        odometry.calibrate(0.1 * scrub * over_read, 1, exact_crossings=False)
+        assert odometry.track_m == 0.1 * scrub * max(over_read, 1.0)
+        odometry.calibrate(0.1 * scrub * over_read, 1, exact_crossings=True)
+        assert odometry.track_m == 0.1 * scrub * over_read

@@ -561,7 +561,8 @@ class Navigator:
             # odometry over-reads rotation by full_turn / 2 pi: the effective track is
             # that much wider; average over all scans so one noisy turn counts little
             self._tracks.append(used * scan.full_turn / (2.0 * math.pi))
-            self.odometry.calibrate(sum(self._tracks) / len(self._tracks), len(self._tracks))
+            self.odometry.calibrate(sum(self._tracks) / len(self._tracks), len(self._tracks),
+                                    exact_crossings=self.line_filter.window == 1)
         scale = used / self.odometry.track_m  # true rotation per odometry rotation
         self.odometry.theta = scan.start + scan.swept * scale
         angles = sorted((scan.start + m * scale) % (2.0 * math.pi) for m in scan.mids)
