@@ -171,6 +171,35 @@ def test_no_move_ever_deepens_an_overlap_in_a_random_crowd(seed):
     assert sim.collisions.events  # the crowd did bump
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_the_wall_grid_finds_every_deeper_wall_overlap(seed):
+    """``WallGrid.deeper`` (one compiled pass over a grid of walls) against every wall of
+    ``arena2`` by the reference ``wall_depth``: discs scattered over the arena and beyond it,
+    each moved a few millimetres, many of them into or out of a wall."""
+    from mjswarm.arena.builder import arena_world_spec
+    from mjswarm.core.kinematic import wall_depth
+
+    sim = Simulation(arena_world_spec(load_arena("arena2"), [Pose2D(0.0, 0.0, 0.0)]),
+                     physics="kinematic")
+    grid = sim._drive._walls
+    rng = np.random.default_rng(seed)
+    centre, axes, half, r = grid.centre, grid.axes, grid.half, grid.radius_m
+    near = rng.integers(len(centre), size=4000)  # about a random wall, and anywhere
+    local = rng.uniform(-1.0, 1.0, (4000, 2)) * (half[near] + r + 0.01)
+    now = centre[near] + np.einsum("kij,ki->kj", axes[near], local)
+    lo, hi = centre.min(axis=0) - 0.5, centre.max(axis=0) + 0.5
+    now = np.concatenate([now, rng.uniform(lo, hi, (1000, 2))])
+    before = now + rng.normal(0.0, 0.003, now.shape)
+    brute = np.zeros(len(now), bool)
+    for w in range(len(centre)):
+        walls = np.full(len(now), w)
+        deep = wall_depth(now, centre[walls], axes[walls], half[walls], r)
+        was = wall_depth(before, centre[walls], axes[walls], half[walls], r)
+        brute |= deep > np.maximum(was, 0.0) + OVERLAP_TOL_M
+    assert 100 < brute.sum() < len(now) - 100
+    assert np.array_equal(grid.deeper(before, now), brute)
+
+
 def test_same_seed_same_trajectory():
     def run():
         sim = Simulation(world_spec([Pose2D(0.1 * k, 0.2 * k, k) for k in range(4)]),

@@ -52,8 +52,9 @@ if TYPE_CHECKING:
 PHYSICS = ("dynamic", "kinematic")
 #: Overlap (m) a move may add before the contact rule stops the robot (float rounding).
 OVERLAP_TOL_M = 1e-9
-#: Length (m) of the pieces walls are cut into to find the robots near them.
-WALL_PIECE_M = 0.5
+#: Side (m) of the cells of the grid that lists, per cell, the walls a footprint disc
+#: centred in it may reach (:class:`WallGrid`).
+WALL_CELL_M = 0.25
 #: The chassis geom whose disc is a robot's footprint in plan.
 FOOTPRINT_GEOM = "chassis"
 
@@ -81,16 +82,8 @@ class KinematicDrive:
             raise MjswarmError(f"the kinematic tier needs a '{FOOTPRINT_GEOM}' geom on every robot")
         self.footprint_radius_m = float(m.geom_size[chassis, 0])
         self._footprint_offset = m.geom_pos[chassis, :2].copy()  # in the robot's frame (m)
-        self._walls = _wall_rectangles(m, d, sim.geom_robot)
-        if self._walls is not None:  # walls cut into pieces for the search of nearby robots
-            centre, axes, half = self._walls
-            count = np.maximum(1, np.ceil(2.0 * half[:, 0] / WALL_PIECE_M)).astype(int)
-            self._piece_wall = np.repeat(np.arange(len(count)), count)
-            along = (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count) + 0.5)
-            offset = (along / count[self._piece_wall] * 2.0 - 1.0) * half[self._piece_wall, 0]
-            self._pieces = cKDTree(centre[self._piece_wall] + offset[:, None] * axes[self._piece_wall, 0])
-            self._piece_reach_m = float(np.hypot(WALL_PIECE_M / 2.0, half[:, 1].max())
-                                        + self.footprint_radius_m)
+        walls = _wall_rectangles(m, d, sim.geom_robot)
+        self._walls = None if walls is None else WallGrid(*walls, self.footprint_radius_m)
         qpos_adr = sim._qpos_adr
         self._xy_adr = qpos_adr[:, None] + np.arange(2)
         self._quat_adr = qpos_adr[:, None] + np.arange(3, 7)
@@ -148,12 +141,13 @@ class KinematicDrive:
         touching: set[tuple[int, int]] = set()
         centres = after
         while True:
-            tree = cKDTree(centres)  # one tree for both queries
+            tree = cKDTree(centres)
             pairs, deeper = self._robot_overlaps(before, centres, tree)
             touching.update(map(tuple, pairs[deeper].tolist()))
             anew = np.zeros(len(start), bool)
             anew[pairs[deeper].ravel()] = True
-            anew |= self._wall_overlaps(before, centres, tree)
+            if self._walls is not None:
+                anew |= self._walls.deeper(before, centres)
             anew &= ~stopped
             if not anew.any():
                 break
@@ -176,30 +170,91 @@ class KinematicDrive:
         deeper = depth_now > np.maximum(depth_before, 0.0) + OVERLAP_TOL_M
         return pairs[overlap], deeper[overlap]
 
-    def _wall_overlaps(self, before: np.ndarray, now: np.ndarray, tree: cKDTree) -> np.ndarray:
-        """Robots whose disc overlaps a wall now more than before the tick (``tree``: a
-        k-d tree of ``now``)."""
-        hit = np.zeros(len(now), bool)
-        if self._walls is None:
-            return hit
-        centre, axes, half = self._walls
-        near = tree.sparse_distance_matrix(self._pieces, self._piece_reach_m,
-                                           output_type="ndarray")
-        pair = np.unique(self._piece_wall[near["j"]] * len(now) + near["i"])
-        wall, robot = np.divmod(pair, len(now))
-        depth_now = self._wall_depth(now[robot], centre[wall], axes[wall], half[wall])
-        depth_before = self._wall_depth(before[robot], centre[wall], axes[wall], half[wall])
-        hit[robot[depth_now > np.maximum(depth_before, 0.0) + OVERLAP_TOL_M]] = True
-        return hit
 
-    def _wall_depth(self, discs: np.ndarray, centre: np.ndarray, axes: np.ndarray,
-                    half: np.ndarray) -> np.ndarray:
-        """How far (m) each disc reaches into its rectangle (negative: the gap); one
-        rectangle (centre, unit axes as rows, half sizes) per disc."""
-        local = np.abs(np.einsum("kij,kj->ki", axes, discs - centre)) - half
-        outside = np.hypot(np.maximum(local[:, 0], 0.0), np.maximum(local[:, 1], 0.0))
-        inside = np.minimum(local.max(axis=1), 0.0)
-        return self.footprint_radius_m - (outside + inside)
+class WallGrid:
+    """Which footprint discs (radius ``radius_m``) overlap a wall more at their new centres
+    than at their old ones: :meth:`deeper`, one compiled pass over the robots.
+
+    Walls are plan rectangles (centres (W, 2), unit axes as rows (W, 2, 2), half sizes
+    (W, 2), metres). A uniform grid of ``WALL_CELL_M`` cells over the walls lists in each
+    cell every wall whose bounding box, grown by the radius, meets the cell: a disc that
+    reaches a wall has its centre in such a cell, and a centre outside the grid reaches
+    none. The depth is computed as :func:`wall_depth` computes it, the same operations in
+    the same order (``tests/test_kinematic.py`` checks the two against each other, and
+    against every wall, on random poses).
+    """
+
+    def __init__(self, centre: np.ndarray, axes: np.ndarray, half: np.ndarray,
+                 radius_m: float) -> None:
+        self.centre, self.axes, self.half, self.radius_m = centre, axes, half, radius_m
+        reach = np.abs(axes).transpose(0, 2, 1) @ half[:, :, None]  # AABB half sizes
+        lo = centre - reach[:, :, 0] - radius_m
+        hi = centre + reach[:, :, 0] + radius_m
+        self.origin = lo.min(axis=0)
+        self.shape = (np.floor((hi.max(axis=0) - self.origin) / WALL_CELL_M) + 1).astype(np.int64)
+        c0 = np.floor((lo - self.origin) / WALL_CELL_M).astype(np.int64)
+        c1 = np.floor((hi - self.origin) / WALL_CELL_M).astype(np.int64)
+        cells, owners = [], []
+        for w in range(len(centre)):
+            xs, ys = np.meshgrid(np.arange(c0[w, 0], c1[w, 0] + 1), np.arange(c0[w, 1], c1[w, 1] + 1))
+            cells.append(xs.ravel() * self.shape[1] + ys.ravel())
+            owners.append(np.full(xs.size, w))
+        cells, owners = np.concatenate(cells), np.concatenate(owners)
+        order = np.lexsort((owners, cells))
+        self.cell_walls = owners[order].astype(np.int64)
+        self.cell_start = np.searchsorted(cells[order], np.arange(self.shape.prod() + 1))
+
+    def deeper(self, before: np.ndarray, now: np.ndarray) -> np.ndarray:
+        """Whether each disc (centres ``now`` (N, 2), m) overlaps some wall more than it
+        did at ``before`` by over ``OVERLAP_TOL_M``."""
+        return _deeper(np.ascontiguousarray(before, float), np.ascontiguousarray(now, float),
+                       self.origin, WALL_CELL_M, self.shape, self.cell_start, self.cell_walls,
+                       self.centre, self.axes, self.half, self.radius_m, OVERLAP_TOL_M)
+
+
+def wall_depth(discs: np.ndarray, centre: np.ndarray, axes: np.ndarray, half: np.ndarray,
+               radius_m: float) -> np.ndarray:
+    """How far (m) each disc (centres (K, 2), radius ``radius_m``) reaches into its
+    rectangle (negative: the gap); one rectangle (centre, unit axes as rows, half sizes)
+    per disc. The reference for :class:`WallGrid`."""
+    local = np.abs(np.einsum("kij,kj->ki", axes, discs - centre)) - half
+    outside = np.hypot(np.maximum(local[:, 0], 0.0), np.maximum(local[:, 1], 0.0))
+    inside = np.minimum(local.max(axis=1), 0.0)
+    return radius_m - (outside + inside)
+
+
+@njit(cache=True)
+def _depth(x, y, centre, axes, half, w, radius):  # pragma: no cover (compiled)
+    """:func:`wall_depth` of one disc centred at ``(x, y)`` in wall ``w``."""
+    dx, dy = x - centre[w, 0], y - centre[w, 1]
+    l0 = abs(axes[w, 0, 0] * dx + axes[w, 0, 1] * dy) - half[w, 0]
+    l1 = abs(axes[w, 1, 0] * dx + axes[w, 1, 1] * dy) - half[w, 1]
+    outside = math.hypot(max(l0, 0.0), max(l1, 0.0))
+    inside = min(max(l0, l1), 0.0)
+    return radius - (outside + inside)
+
+
+@njit(cache=True)
+def _deeper(before, now, origin, cell_m, shape, cell_start, cell_walls, centre, axes, half,
+            radius, tol):  # pragma: no cover (compiled)
+    n = now.shape[0]
+    hit = np.zeros(n, np.bool_)
+    for i in range(n):
+        cx = math.floor((now[i, 0] - origin[0]) / cell_m)
+        cy = math.floor((now[i, 1] - origin[1]) / cell_m)
+        if cx < 0 or cy < 0 or cx >= shape[0] or cy >= shape[1]:
+            continue
+        cell = cx * shape[1] + cy
+        for k in range(cell_start[cell], cell_start[cell + 1]):
+            w = cell_walls[k]
+            deep = _depth(now[i, 0], now[i, 1], centre, axes, half, w, radius)
+            if deep <= tol:
+                continue
+            was = _depth(before[i, 0], before[i, 1], centre, axes, half, w, radius)
+            if deep > max(was, 0.0) + tol:
+                hit[i] = True
+                break
+    return hit
 
 
 def _wall_rectangles(m: mujoco.MjModel, d: mujoco.MjData,
