@@ -200,6 +200,28 @@ def test_the_wall_grid_finds_every_deeper_wall_overlap(seed):
     assert np.array_equal(grid.deeper(before, now), brute)
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_the_robot_overlaps_are_every_overlapping_pair(seed):
+    """``KinematicDrive._robot_overlaps`` (one compiled pass over cells of a disc's
+    diameter) against every pair by numpy: the same pairs in the same order, the same
+    verdicts, on a crowd of 400 discs in a 3 m square, each moved a few millimetres."""
+    sim = Simulation(world_spec([Pose2D(0.0, 0.0, 0.0)]), physics="kinematic")
+    drive = sim._drive
+    rng = np.random.default_rng(seed)
+    now = rng.uniform(-1.5, 1.5, (400, 2))
+    before = now + rng.normal(0.0, 0.003, now.shape)
+    reach = 2.0 * drive.footprint_radius_m
+    i, j = np.triu_indices(len(now), 1)
+    depth = reach - np.linalg.norm(now[i] - now[j], axis=1)
+    was = reach - np.linalg.norm(before[i] - before[j], axis=1)
+    overlap = depth > 0.0
+    pairs, deeper = drive._robot_overlaps(before, now)
+    assert len(pairs) > 50
+    assert np.array_equal(pairs, np.column_stack([i, j])[overlap])
+    assert np.array_equal(deeper, (depth > np.maximum(was, 0.0) + OVERLAP_TOL_M)[overlap])
+    assert deeper.any() and not deeper.all()
+
+
 def test_same_seed_same_trajectory():
     def run():
         sim = Simulation(world_spec([Pose2D(0.1 * k, 0.2 * k, k) for k in range(4)]),

@@ -41,7 +41,6 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 from numba import njit
-from scipy.spatial import cKDTree
 
 from mjswarm.errors import MjswarmError
 
@@ -141,8 +140,7 @@ class KinematicDrive:
         touching: set[tuple[int, int]] = set()
         centres = after
         while True:
-            tree = cKDTree(centres)
-            pairs, deeper = self._robot_overlaps(before, centres, tree)
+            pairs, deeper = self._robot_overlaps(before, centres)
             touching.update(map(tuple, pairs[deeper].tolist()))
             anew = np.zeros(len(start), bool)
             anew[pairs[deeper].ravel()] = True
@@ -156,19 +154,55 @@ class KinematicDrive:
         touching.update(map(tuple, pairs.tolist()))  # what still overlaps at the final poses
         return stopped, touching
 
-    def _robot_overlaps(self, before: np.ndarray, now: np.ndarray,
-                        tree: cKDTree) -> tuple[np.ndarray, np.ndarray]:
-        """Robot pairs ``(i, j)``, i < j, whose discs overlap now (``tree``: a k-d tree of
-        ``now``), and whether each overlaps more than before the tick."""
-        reach = 2.0 * self.footprint_radius_m
-        pairs = tree.query_pairs(reach, output_type="ndarray").reshape(-1, 2)
-        pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
-        gap_now = np.linalg.norm(now[pairs[:, 0]] - now[pairs[:, 1]], axis=1)
-        gap_before = np.linalg.norm(before[pairs[:, 0]] - before[pairs[:, 1]], axis=1)
-        depth_now, depth_before = reach - gap_now, reach - gap_before
-        overlap = depth_now > 0.0
-        deeper = depth_now > np.maximum(depth_before, 0.0) + OVERLAP_TOL_M
-        return pairs[overlap], deeper[overlap]
+    def _robot_overlaps(self, before: np.ndarray, now: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Robot pairs ``(i, j)``, i < j, sorted, whose discs (centres ``now``, m) overlap,
+        and whether each overlaps more than at ``before``; one compiled pass over the robots
+        binned into cells of a disc's diameter (a k-d tree's ``query_pairs`` plus the same
+        test in numpy costed about 180 us a tick at 1000 robots)."""
+        i, j, deeper = _overlapping_pairs(np.ascontiguousarray(before, float),
+                                          np.ascontiguousarray(now, float),
+                                          2.0 * self.footprint_radius_m, OVERLAP_TOL_M)
+        order = np.lexsort((j, i))
+        return np.column_stack([i[order], j[order]]), deeper[order]
+
+
+@njit(cache=True)
+def _overlapping_pairs(before, now, reach, tol):  # pragma: no cover (compiled)
+    """Every pair ``i < j`` of discs whose centres ``now`` lie less than ``reach`` apart
+    (``reach - |c_i - c_j| > 0``), found among the discs of the 3 x 3 cells of side
+    ``reach`` around each; and whether ``reach - gap`` grew by more than ``tol`` over its
+    value at ``before`` (or over none). Gaps as ``numpy.linalg.norm`` takes them."""
+    n = now.shape[0]
+    found_i, found_j, found_deeper = [0][:0], [0][:0], [False][:0]
+    if n < 2:
+        return np.array(found_i, np.int64), np.array(found_j, np.int64), np.array(found_deeper)
+    lo0, lo1 = now[:, 0].min(), now[:, 1].min()
+    cx = np.floor((now[:, 0] - lo0) / reach).astype(np.int64) + 1
+    cy = np.floor((now[:, 1] - lo1) / reach).astype(np.int64) + 1
+    stride = cy.max() + 2
+    key = cx * stride + cy
+    order = np.argsort(key)
+    sorted_key = key[order]
+    for i in range(n):
+        for ox in range(-1, 2):
+            for oy in range(-1, 2):
+                k = key[i] + ox * stride + oy
+                for t in range(np.searchsorted(sorted_key, k),
+                               np.searchsorted(sorted_key, k, side="right")):
+                    j = order[t]
+                    if j <= i:
+                        continue
+                    d0, d1 = now[i, 0] - now[j, 0], now[i, 1] - now[j, 1]
+                    depth = reach - math.sqrt(d0 * d0 + d1 * d1)
+                    if depth <= 0.0:
+                        continue
+                    b0, b1 = before[i, 0] - before[j, 0], before[i, 1] - before[j, 1]
+                    was = reach - math.sqrt(b0 * b0 + b1 * b1)
+                    found_i.append(i)
+                    found_j.append(j)
+                    found_deeper.append(depth > max(was, 0.0) + tol)
+    return (np.array(found_i, np.int64), np.array(found_j, np.int64),
+            np.array(found_deeper, np.bool_))
 
 
 class WallGrid:
