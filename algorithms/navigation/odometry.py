@@ -20,6 +20,7 @@ SCAN_OVER_READ_SPREAD = 0.003
 #: of 0.01 (0.8 %) from the fourth.
 OVER_READ_SIGMAS = 5.0
 
+
 @dataclass(frozen=True)
 class RobotCalibration:
     """What a robot knows about its own body (metres, radians).
