@@ -104,7 +104,7 @@ class Odometry:
         scans' mean over-read beyond the floor's scrub (``turn_over_read``) divides the
         distance, once it lies ``OVER_READ_SIGMAS`` standard errors
         (``SCAN_OVER_READ_SPREAD / sqrt(scans)``) above none; till then the scale stays
-        1, so that noise-free and line-noise runs keep their trajectories to the bit.
+        1, so that runs without slip drive by their encoders' own distance.
 
         The track: with ``exact_crossings`` (the line readings are noise-free enough for
         the line filter to pass single readings) a scan's crossings are placed to half a

@@ -174,7 +174,7 @@ def _overlapping_pairs(before, now, reach, tol):  # pragma: no cover (compiled)
     sort); and whether ``reach - gap`` grew by more than ``tol`` over its value at
     ``before`` (or over none). Gaps as ``numpy.linalg.norm`` takes them."""
     n = now.shape[0]
-    found_i, found_j, found_deeper = [0][:0], [0][:0], [False][:0]
+    found_i, found_j, found_deeper = [0][:0], [0][:0], [False][:0]  # empty, typed for numba
     if n < 2:
         return np.array(found_i, np.int64), np.array(found_j, np.int64), np.array(found_deeper)
     lo0, lo1 = now[:, 0].min(), now[:, 1].min()
