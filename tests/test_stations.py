@@ -261,3 +261,33 @@ def test_a_give_up_that_crosses_its_grant_leaves_the_grant_standing():
     run.uplink.step()
     assert run.uplink.receive_for(0) == [] and run.stations.gave_up == 0
     assert run.stations.target[0] == w and run.stations.stations.holder[w] == 0
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_nearest_vertex_by_the_whole_matrix_equals_the_k_d_tree(monkeypatch, seed):
+    """Below ``NEAREST_TREE_FROM`` robot-vertex pairs the stations find each robot's
+    vertex from the whole distance matrix; the k-d tree gives the same vertices and
+    distances (robots anywhere on and off the arena, some on vertex centres)."""
+    from mjswarm.experiments import stations
+
+    class Sim:  # the two things NearestVertex reads of a simulation
+        def __init__(self, xy):
+            self.n, self.state_version, self._xy = len(xy), 0, xy
+
+        def poses(self):
+            return np.column_stack([self._xy, np.zeros(self.n)])
+
+    spec = load_arena(["arena2", "lattice:5x4", "hex:3x3"][seed % 3])
+    rng = np.random.default_rng(seed)
+    vertices = np.array(list(spec.vertices.values()))
+    lo, hi = vertices.min(axis=0) - 0.5, vertices.max(axis=0) + 0.5
+    xy = rng.uniform(lo, hi, (40, 2))
+    xy[:5] = vertices[rng.integers(len(vertices), size=5)]  # standing on centres
+    answers = []
+    for tree_from in (10**9, 0):  # the matrix, then the tree
+        monkeypatch.setattr(stations, "NEAREST_TREE_FROM", tree_from)
+        nearest = stations.NearestVertex(Sim(xy), spec)
+        assert (nearest._tree is None) == (tree_from > 0)
+        answers.append([nearest(i) for i in range(len(xy))])
+    assert answers[0] == answers[1]
+    assert all(d == 0.0 for _, d in answers[0][:5])

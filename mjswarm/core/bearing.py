@@ -69,6 +69,8 @@ class BearingSensor:
             return (np.empty(0, np.int64),) * 2 + (np.empty(0),)
         poses = sim.poses()
         pairs = sim.neighbours.pairs(poses[:, :2], self.range_m)
+        if not len(pairs):  # nobody within range of anybody
+            return (np.empty(0, np.int64),) * 2 + (np.empty(0),)
         k = np.concatenate([pairs[:, 0], pairs[:, 1]])
         p = np.concatenate([pairs[:, 1], pairs[:, 0]])
         x, y, yaw = poses.T

@@ -47,11 +47,11 @@ class CollisionCounter:
         """Robot pairs ``(i, j)`` with ``i < j`` in contact in ``data`` right now."""
         if data.ncon == 0:
             return set()
-        geoms = data.contact.geom[: data.ncon]
-        robots = self._geom_robot[geoms]
-        mask = (robots[:, 0] >= 0) & (robots[:, 1] >= 0) & (robots[:, 0] != robots[:, 1])
-        if not mask.any():
+        robots = self._geom_robot[data.contact.geom[: data.ncon]]
+        both = robots.min(axis=1) >= 0  # both geoms on robots (most contacts are the floor's)
+        if not both.any():
             return set()
+        mask = both & (robots[:, 0] != robots[:, 1])
         pairs = np.sort(robots[mask], axis=1)
         return {(int(a), int(b)) for a, b in pairs}
 

@@ -39,7 +39,8 @@ class Neighbours:
         self._columns = np.empty((0, 0))  # their coordinates, one row per axis
         self._tree: cKDTree | None = None
         self._answers: dict[float, np.ndarray] = {}  # range (m) -> its pairs at ``_key``
-        self._every: tuple[int, np.ndarray, np.ndarray] = (0, *np.triu_indices(0, 1))
+        #: every pair of ``n`` robots: ``(n, k, l, kl)``, ``kl`` the pairs as rows
+        self._every: tuple[int, np.ndarray, np.ndarray, np.ndarray] = _every_pair(0)
 
     def pairs(self, xy: np.ndarray, range_m: float) -> np.ndarray:
         """Every pair ``(k, l)``, ``k < l``, of rows of ``xy`` (finite, metres) at most
@@ -62,10 +63,11 @@ class Neighbours:
         n = columns.shape[1]
         if n < 2:
             return np.empty((0, 2), np.int64)
+        pairs = None
         if n < TREE_FROM_ROBOTS:
             if self._every[0] != n:
-                self._every = (n, *np.triu_indices(n, 1))
-            _, k, l = self._every
+                self._every = _every_pair(n)
+            _, k, l, pairs = self._every
         else:
             if self._tree is None:
                 self._tree = cKDTree(columns.T, balanced_tree=False, compact_nodes=False)
@@ -75,4 +77,13 @@ class Neighbours:
         for column in columns[1:]:
             gap += (column[k] - column[l]) ** 2
         within = gap <= range_m**2
+        if pairs is not None:  # every pair: one row pick
+            return pairs[within]
         return np.column_stack([k[within], l[within]])
+
+
+def _every_pair(n: int) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+    """Every pair ``(k, l)``, ``k < l``, of ``n`` robots in key order: ``(n, k, l, kl)``,
+    ``kl`` the same pairs as the rows of one (M, 2) array."""
+    k, l = np.triu_indices(n, 1)
+    return n, k, l, np.column_stack([k, l])

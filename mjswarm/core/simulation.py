@@ -65,6 +65,9 @@ READING_DTYPE = np.dtype(
     ]
 )
 
+#: MuJoCo's flag that switches its sensor stage off (as an int: ``opt.disableflags``)
+SENSOR_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+
 SENSING = ("auto", "grid", "mujoco")
 #: Robot count from which ``sensing="auto"`` casts rays on the grid (``mjswarm bench
 #: --sensing grid`` and ``--sensing mujoco`` measure the two; README, "Benchmark").
@@ -99,14 +102,13 @@ def _check_options(control_hz: float, line_noise_m: float, ir_noise_m: float,
 
 def _compile(spec: mujoco.MjSpec, physics: str, sensing: str) -> mujoco.MjModel:
     """Compile the world, with MuJoCo's sensors off when the ray caster will sense."""
-    sensor_bit = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
     flags = spec.option.disableflags
     if physics == "kinematic" or sensing == "grid" or (
             sensing == "auto" and _robot_count(spec) >= GRID_SENSING_MIN_ROBOTS):
         # compiling evaluates every sensor once (mj_setConst steps through mj_forward):
         # for grid sensing, N robots' rangefinders against every geom, O(N^2), that
         # nobody reads (20 s of a 10,000-robot build); the flag is set below anyway
-        spec.option.disableflags = flags | sensor_bit
+        spec.option.disableflags = flags | SENSOR_OFF
     try:
         with quiet_empty_prefix():  # robots attached in groups (world.attach_robots)
             return spec.compile()
@@ -188,7 +190,7 @@ class Simulation:
         #: bearing sensor and the radio (:mod:`mjswarm.core.neighbours`)
         self.neighbours = Neighbours()
         if sensing == "grid":
-            m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+            m.opt.disableflags |= SENSOR_OFF
             mujoco.mj_kinematics(m, self.data)
         # a world grid sensing cannot cast fails here, in one line
         self._rays = RayCaster(m, self.data, self.robot_bodies, geom_robot) if sensing == "grid" else None
@@ -332,7 +334,6 @@ class Simulation:
         """Advance ``ticks`` control periods (each ``substeps`` physics steps, or one
         kinematic tick of as long in the kinematic tier)."""
         m, d = self.model, self.data
-        sensor_bit = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
         for _ in range(ticks):
             if self._drive is not None:
                 touching = self._drive.step(self.substeps)
@@ -340,10 +341,10 @@ class Simulation:
                 torque = self._no_torque
             else:
                 if self.substeps > 1:
-                    m.opt.disableflags |= sensor_bit
+                    m.opt.disableflags |= SENSOR_OFF
                     mujoco.mj_step(m, d, nstep=self.substeps - 1)
                     if self.sensing == "mujoco":
-                        m.opt.disableflags &= ~sensor_bit
+                        m.opt.disableflags &= ~SENSOR_OFF
                 if self.sensing == "grid":
                     self._wheels = self._wheel_state()  # the state the last step's sensors see
                 mujoco.mj_step(m, d)
@@ -400,7 +401,8 @@ class Simulation:
             out["encoder"], out["wheel_speed"] = sd[self._enc_adr], sd[self._vel_adr]
         else:
             out["encoder"], out["wheel_speed"] = self._wheels
-        out["encoder"] += self._slip_rad
+        if self.wheel_slip:
+            out["encoder"] += self._slip_rad
         out["battery"] = self.battery.voltage_v
         return out
 
@@ -421,8 +423,10 @@ class Simulation:
         if self._poses_version != self.state_version:
             q = self.data.qpos[self._pose_qpos]
             w, x, y, z = q[:, 3], q[:, 4], q[:, 5], q[:, 6]
-            yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-            self._poses = np.column_stack([q[:, 0], q[:, 1], yaw])
+            poses = np.empty((self.n, 3))
+            poses[:, :2] = q[:, :2]
+            poses[:, 2] = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+            self._poses = poses
             self._poses_version = self.state_version
         return self._poses.copy()
 

@@ -214,16 +214,25 @@ class VertexStations:
             chain.append(holder)
 
 
+#: Robot-by-vertex distances from which :class:`NearestVertex` asks a k-d tree: below, the
+#: whole matrix costs less than the tree's query (the main job's 4 robots by 10 vertices:
+#: about 4 us against 14 us a state).
+NEAREST_TREE_FROM = 4096
+
+
 class NearestVertex:
     """Which vertex each robot of ``sim`` is nearest to, and how far (m): what the
     stations see. Worked out once per world state, for every robot at once, by a k-d tree
     over the vertices (a robot-by-vertex distance matrix took 5.3 of 9.4 s of a 1000-robot
-    ``lattice:30x30`` run's first 20 s; ``tree.query`` is ``O(N log V)``)."""
+    ``lattice:30x30`` run's first 20 s; ``tree.query`` is ``O(N log V)``), or by the
+    whole matrix below ``NEAREST_TREE_FROM`` robot-vertex pairs (the same vertices: a
+    robot exactly halfway between two is the only case the two could answer apart)."""
 
     def __init__(self, sim, spec: ArenaSpec) -> None:
         self.sim = sim
         self._xy = np.array(list(spec.vertices.values()))
-        self._tree = cKDTree(self._xy)
+        self._tree = (cKDTree(self._xy) if sim.n * len(self._xy) >= NEAREST_TREE_FROM
+                      else None)
         self._ids = list(spec.vertices)
         self._version = -1
         self._nearest = self._distance = None
@@ -232,11 +241,16 @@ class NearestVertex:
         sim = self.sim
         if self._version != sim.state_version:
             xy = sim.poses()[:, :2]
-            self._nearest = self._tree.query(xy)[1]
+            if self._tree is not None:
+                self._nearest = self._tree.query(xy)[1]
+            else:
+                gap = xy[:, None, :] - self._xy[None, :, :]
+                self._nearest = np.einsum("nvk,nvk->nv", gap, gap).argmin(axis=1)
             v = self._xy[self._nearest]
-            self._distance = np.hypot(xy[:, 0] - v[:, 0], xy[:, 1] - v[:, 1])
+            distance = np.hypot(xy[:, 0] - v[:, 0], xy[:, 1] - v[:, 1])
+            self._nearest, self._distance = self._nearest.tolist(), distance.tolist()
             self._version = sim.state_version
-        return self._ids[self._nearest[i]], float(self._distance[i])
+        return self._ids[self._nearest[i]], self._distance[i]
 
 
 class StationService(LoopFunctions):
