@@ -183,6 +183,39 @@ def test_leaving_a_vertex_takes_its_own_lane_not_the_corner_of_a_neighbours():
     assert ours(at(start, 0.0), (True, True, False)) is True
 
 
+@pytest.mark.parametrize("across_mm", [-12.0, 0.0, 12.0])
+def test_leaving_a_vertex_does_not_take_a_neighbours_spoke_for_its_lane(across_mm):
+    """Edges 45 degrees apart (``wheel:4@8`` at ``r2``): leaving towards ``c``, the right
+    sensor ends the sidestep a few millimetres beside the outer end of the spoke towards
+    ``r1``, 45 degrees to the left. A sensor on that spoke (anywhere across its 30 mm
+    strip) is not on the lane sought (issue 27: with slip 0.05 a robot took it for its
+    lane, followed it off the vertex and was lost); a sensor on the lane's start is."""
+    spec = load_arena("wheel:4@8")
+    sim = Simulation(arena_world_spec(spec, [Pose2D(*spec.vertices["r2"], 0.0)]))
+    cal, conv = calibration(sim.geometry), conventions(sim.geometry)
+    centre = np.asarray(spec.vertices["r2"])
+    angle = incidence_angle(spec, "r2", "c")
+    nav = Navigator(cal, conv, angle, SPEED_M_S)
+    nav.odometry.x, nav.odometry.y = centre
+    nav.edge_angles = [incidence_angle(spec, "r2", w) for w in ("c", "r1", "r3")]
+    ours = nav._own_lane(angle)
+    u = np.array([math.cos(angle), math.sin(angle)])
+    n = np.array([-u[1], u[0]])
+
+    def at(sensor_xy, side_m):  # the pose, heading along the edge, that puts the sensor there
+        xy = np.asarray(sensor_xy) - cal.line_ahead_m * u - side_m * n
+        nav.odometry.x, nav.odometry.y = xy
+        return nav.odometry
+
+    spoke = incidence_angle(spec, "r2", "r1")
+    along, normal = np.array([math.cos(spoke), math.sin(spoke)]), np.array([-math.sin(spoke), math.cos(spoke)])
+    on_spoke = centre + (conv.spoke_radius_m - 0.002) * along + across_mm / 1000.0 * normal
+    assert ours(at(on_spoke, -cal.line_spacing_m), (False, False, True)) is False
+    own = {s.travel: s for s in lane_strips(spec)}[("r2", "c")]
+    start = np.asarray(own.start) + 0.001 * u
+    assert ours(at(start, 0.0), (False, True, False)) is True
+
+
 def _unit(p, q):
     d = np.asarray(q, float) - np.asarray(p, float)
     return d / np.linalg.norm(d)

@@ -216,7 +216,8 @@ def test_the_speed_rule_sees_bearings_along_the_lane_not_the_swung_nose():
     cal = RobotCalibration(wheel_radius_m=0.02, track_m=0.1, line_ahead_m=0.05,
                            max_speed_m_s=0.2)
     conv = ArenaConventions(lane_offset_m=0.09, spoke_inner_radius_m=0.03,
-                            spoke_radius_m=0.12, wall_distance_m=0.024, strip_width_m=0.03)
+                            spoke_radius_m=0.12, wall_distance_m=0.024, strip_width_m=0.03,
+                            lane_start_m=0.16)
     nav = Navigator(cal, conv, -math.pi / 2, 0.2)
     wheels = [0.0, 0.0]
     dt = 0.02

@@ -45,4 +45,5 @@ def conventions(geom: RobotGeometry) -> ArenaConventions:
         spoke_radius_m=geometry.SPOKE_RADIUS_M,
         wall_distance_m=wall_face - geometry.LANE_OFFSET_M - geom.ir_side_offset_m,
         strip_width_m=geometry.STRIP_WIDTH_M,
+        lane_start_m=geometry.LANE_END_RADIUS_M,
     )
