@@ -639,9 +639,11 @@ def sight_blocker(sim: Simulation, fixed: Mapping[Hashable, tuple[float, float]]
 
     def between_robots(pairs: np.ndarray) -> np.ndarray:
         i, j = np.asarray(pairs, np.int64).reshape(-1, 2).T
-        seen = sim.sight(i, j)  # the way back only where the way there is clear
-        seen[seen] = sim.sight(j[seen], i[seen])
-        return ~seen
+        # both ways in one cast: the way back of a blocked way there is not needed, but
+        # one call costs less than merging a second one into the state's answers, and the
+        # bearing sensor then finds its pairs in range already answered
+        seen = sim.sight(np.concatenate([i, j]), np.concatenate([j, i]))
+        return ~(seen[:len(i)] & seen[len(i):])
 
     if not fixed:
         return between_robots

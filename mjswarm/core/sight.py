@@ -101,7 +101,7 @@ class LineOfSight:
         """Index of each key among the answered ones, -1 where not answered yet."""
         if not len(self._keys):
             return np.full(len(key), -1)
-        at = np.searchsorted(self._keys, key).clip(max=len(self._keys) - 1)
+        at = np.minimum(np.searchsorted(self._keys, key), len(self._keys) - 1)
         return np.where(self._keys[at] == key, at, -1)
 
     def _cast(self, k: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -172,7 +172,8 @@ def _multi_ray(model: mujoco.MjModel, data: mujoco.MjData, origin: np.ndarray, s
     if not n:
         return geom
     order = np.argsort(origin, kind="stable")
-    cuts = (np.flatnonzero(np.diff(origin[order])) + 1).tolist()
+    origin = origin[order]
+    cuts = (np.flatnonzero(origin[1:] != origin[:-1]) + 1).tolist()
     start, unit = np.ascontiguousarray(start[order], float), np.ascontiguousarray(unit[order], float)
     exclude = exclude[order].tolist()
     hit = np.empty(n, np.int32)
