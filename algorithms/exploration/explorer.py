@@ -47,7 +47,8 @@ Choices beyond the paper (the loop functions in :mod:`mjswarm.experiments.explor
   accumulate over revisits and every robot keeps the beacons' frame. Frame fusion
   (prototype, issue 27): the robot that drops a beacon writes its frame's variance there
   (``Beacon.frame``: its heading variance plus a scan's), and a robot that has found slip
-  turns only part of the way onto a stored frame, by the two variances
+  turns only part of the way onto a stored frame, by the two variances, and moves the
+  beacon's believed offset part of the way towards its own frame
   (:func:`~algorithms.navigation.navigator.fuse_frames`). The stored angles themselves
   never move: they name the vertex's edges in every robot's incidence matrix, matched
   within ``ANGLE_TOLERANCE``, and copies of them live in every matrix merged since.
@@ -576,6 +577,8 @@ class Explorer(Controller):
         consulted = cx is None or cx.consulted
         if consulted and self.strategy.stored_angles is not None:  # re-anchoring
             nav.reanchor(self.strategy.stored_angles, beacon.frame)
+            if nav.beacon_frame is not None:
+                beacon.frame = nav.beacon_frame
         elif self.strategy.stored_angles is None and beacon.frame is None:
             # it dropped the beacon: its angles are in its own frame, as sure as its heading
             beacon.frame = (0.0, nav.heading_variance + SCAN_FRAME_VAR)

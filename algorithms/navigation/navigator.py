@@ -166,6 +166,10 @@ class Navigator:
         #: aligned with the common frame)
         self._var_rad2 = 0.0
         self._var_wheel_sq = 0.0
+        self._fused_scan = -1  # the scan whose angles it fused last
+        #: after :meth:`reanchor` fused frames: the beacon's frame ``(offset, variance)``
+        #: updated by this visit, for the caller to write back; else None
+        self.beacon_frame: tuple[float, float] | None = None
         self._lane: FollowLine | None = None
         self._left: tuple[float, float, float] | None = None  # centre x, y and angle it left by
         #: x, y and heading (odometry) where its lane ended
@@ -317,12 +321,21 @@ class Navigator:
         by :func:`frame_offset` of the measured angles against ``stored``; returns that
         rotation (rad). With ``beacon_frame`` (the beacon's ``(offset, variance)``: how
         far its stored angles are believed to lie from the common frame, rad and rad^2)
-        and :attr:`fuses_frames`, only by :func:`fuse_frames`' share of it, and the
-        robot's :attr:`heading_variance` shrinks accordingly."""
+        and :attr:`fuses_frames`, by :func:`fuse_frames`' share of it instead: its
+        :attr:`heading_variance` shrinks accordingly, and :attr:`beacon_frame` is what the
+        caller writes back into the beacon. A robot fuses once per scan: a second call at
+        the same vertex (after idling, a queue given up) measured nothing new and turns
+        it by nothing."""
+        self.beacon_frame = None
         delta_rad = frame_offset(self.edge_angles, stored)
         if beacon_frame is not None and self.fuses_frames:
-            delta_rad, var = fuse_frames(delta_rad, self.heading_variance, *beacon_frame)
+            if self._fused_scan == self._scans:
+                return 0.0
+            self._fused_scan = self._scans
+            delta_rad, var, offset, beacon_var = fuse_frames(
+                delta_rad, self.heading_variance, *beacon_frame)
             self._var_rad2, self._var_wheel_sq = var, self.odometry.wheel_sq
+            self.beacon_frame = (offset, beacon_var)
         self.odometry.correct_heading(delta_rad)
         self.edge_angles = sorted((a + delta_rad) % (2.0 * math.pi) for a in self.edge_angles)
         if self.arrived_angle is not None:
@@ -619,24 +632,34 @@ SCAN_FRAME_VAR = math.radians(0.9) ** 2
 
 
 def fuse_frames(delta_rad: float, robot_var: float, beacon_offset: float,
-                beacon_var: float) -> tuple[float, float]:
-    """A scalar Kalman update of a robot's heading on a revisit (ours, issue 27's frame
-    fusion prototype): ``(correction, variance after)``, rad and rad^2.
+                beacon_var: float) -> tuple[float, float, float, float]:
+    """A scalar Kalman update of a robot's heading and a beacon's frame on a revisit
+    (ours, issue 27's frame fusion prototype): ``(correction, robot variance after,
+    beacon offset after, beacon variance after)``, rad and rad^2.
 
     ``delta_rad`` is :func:`frame_offset` of the robot's measured angles onto the beacon's
     stored ones: the beacon frame's error minus the robot's, plus a scan's error
     (``SCAN_FRAME_VAR``). The beacon believes its frame lies ``beacon_offset`` off the
     common frame, with variance ``beacon_var``; the robot believes its own heading
-    unbiased, with variance ``robot_var``. The innovation ``delta - beacon_offset`` is
-    then the robot's error with variance ``S = robot_var + beacon_var + SCAN_FRAME_VAR``,
-    and the robot turns by ``k (delta - beacon_offset)``, ``k = robot_var / S``: fully
-    onto the beacon's frame when its own heading is much less sure (the old re-anchoring,
-    ``k = 1``), hardly at all when the beacon's is (a robot fresh from the root meeting a
-    deep vertex). The two errors are taken as independent; a robot back at a vertex whose
-    frame it took before shares part of its error with it, and then fuses too little."""
+    unbiased, with variance ``robot_var``. The innovation ``y = delta - beacon_offset``
+    has variance ``S = robot_var + beacon_var + SCAN_FRAME_VAR``:
+
+    * the robot turns by ``k y``, ``k = robot_var / S``: fully onto the beacon's frame
+      when its own heading is much less sure (the old re-anchoring, ``k = 1``), hardly at
+      all when the beacon's is (a robot fresh from the root meeting a deep vertex);
+    * the beacon's offset moves by ``(beacon_var / S) y`` towards the robot's frame, and
+      its variance shrinks alike. Its stored angles never move (they name its edges in
+      every robot's incidence matrix, matched within ``ANGLE_TOLERANCE``); the offset is
+      what a later visitor subtracts.
+
+    The two errors are taken as independent (no cross-covariance is kept): a robot back at
+    a vertex whose frame it took before shares part of its error with it, and the update
+    then trusts the pair a little too much (over issue 27's slip runs the robots' squared
+    errors average 1.3 times their variance, the beacons' 1.0 times)."""
     s = robot_var + beacon_var + SCAN_FRAME_VAR
-    k = robot_var / s
-    return k * (delta_rad - beacon_offset), robot_var * (1.0 - k)
+    y = delta_rad - beacon_offset
+    k, kb = robot_var / s, beacon_var / s
+    return k * y, robot_var * (1.0 - k), beacon_offset + kb * y, beacon_var * (1.0 - kb)
 
 
 def frame_offset(measured: Sequence[float], stored: Sequence[float]) -> float:
