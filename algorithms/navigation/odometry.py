@@ -160,8 +160,11 @@ class Odometry:
         :attr:`wheel_sq`: per update the heading errs by ``r (dr e_r - dl e_l) / b``, the
         two wheels' over-reads ``e`` independent with spread :attr:`slip_sigma` (their
         mean is calibrated out), so its variance is ``(r / b)^2 (dl^2 + dr^2) sigma^2``,
-        summed over updates: a straight metre at 0.15 m/s and 50 Hz adds about
-        (1.3 deg)^2 at slip 0.05, a scan's whole turn (0.4 deg)^2."""
+        summed over updates: for the Spark V (r 25 mm, b 0.12 m) at slip 0.05 a straight
+        metre at 0.15 m/s and 50 Hz adds about (1.1 deg)^2, a scan's whole turn at 1 rad/s
+        (0.4 deg)^2. On issue 27's slip runs the heading's drift from one vertex call to
+        the next is 1.13 degrees rms against 0.99 modelled (1070 legs; along the lanes
+        alone 0.75 against 0.74)."""
         k = self.cal.wheel_radius_m / self.track_m * self.slip_sigma
         return k * k * (self.wheel_sq - wheel_sq)
 
