@@ -10,7 +10,7 @@ import pytest
 
 from algorithms.navigation import Navigator, NavigatorState
 from algorithms.navigation.driving import Navigating
-from algorithms.navigation.navigator import frame_offset
+from algorithms.navigation.navigator import SCAN_FRAME_VAR, frame_offset, fuse_frames
 from mjswarm.arena import incidence_angle, load_arena
 from mjswarm.arena.builder import arena_world_spec
 from mjswarm.worlds.loop import Loop
@@ -43,6 +43,42 @@ def test_frame_offset_recovers_the_rotation(seed):
     cost = [sum(math.cos(s - m - g) for s, m in zip(stored, measured)) for g in grid]
     assert got == pytest.approx(grid[int(np.argmax(cost))], abs=1e-3)
     assert abs(got - delta) < math.radians(0.5) * 3
+
+
+def test_frame_fusion_weighs_the_two_frames_by_their_variances():
+    """fuse_frames (issue 27's frame fusion): a robot as sure as the truth keeps its
+    heading and moves the beacon's offset all the way; one much less sure than the beacon
+    adopts the beacon's frame (the old re-anchoring); equal variances split the offset."""
+    d = math.radians(4.0)
+    keep, var, offset, bvar = fuse_frames(d, 0.0, 0.0, math.radians(3.0) ** 2)
+    assert keep == 0.0 and var == 0.0
+    assert offset == pytest.approx(d * 9 / (9 + 0.81))
+    adopt, var, offset, bvar = fuse_frames(d, 1.0, 0.0, 0.0)
+    assert adopt == pytest.approx(d, rel=1e-3) and offset == 0.0 and bvar == 0.0
+    v = math.radians(2.0) ** 2
+    half, var, offset, bvar = fuse_frames(d, v, 0.0, v)
+    assert half == pytest.approx(d * v / (2 * v + SCAN_FRAME_VAR))
+    assert offset == pytest.approx(half) and var == pytest.approx(bvar) and var < v
+    # the beacon's believed offset is subtracted first: what it already knows moves no one
+    none, *_ = fuse_frames(d, v, d, v)
+    assert none == 0.0
+
+
+def test_the_slip_a_robot_finds_sets_its_heading_variance():
+    """Odometry.slip_sigma from the calibrated distance scale (0.8 S at slip S), and the
+    heading variance it adds per wheel turn; none without slip found (so noise-free runs
+    re-anchor fully, as before)."""
+    from algorithms.navigation.odometry import Odometry, RobotCalibration
+    odo = Odometry(RobotCalibration(wheel_radius_m=0.03, track_m=0.1, line_ahead_m=0.05,
+                                    max_speed_m_s=0.2))
+    odo.update((0.0, 0.0))
+    odo.update((1.0, 1.0))
+    assert odo.wheel_sq == 2.0
+    assert odo.slip_sigma == 0.0 and odo.heading_variance_since(0.0) == 0.0
+    odo.distance_scale = 1.0 + 0.05 * math.sqrt(2 / math.pi)
+    assert odo.slip_sigma == pytest.approx(0.05 * math.sqrt(1 - 2 / math.pi))
+    assert odo.heading_variance_since(0.0) == pytest.approx(
+        (0.3 * odo.slip_sigma) ** 2 * 2.0)
 
 
 @pytest.mark.parametrize("direction", [1, -1])
@@ -151,3 +187,19 @@ def test_a_lone_robot_under_line_noise_keeps_its_heading():
     result = explore_embodied(load_arena("fan:3:45@17"), 1, config=config, seed=1)
     assert result.completed and result.map_correct and result.collisions == 0
     assert result.heading_error_deg < 2.0
+
+
+def test_frame_fusion_keeps_a_slipping_teams_heading():
+    """``hex:3x3``, 3 robots at 0.15 m/s, slip 0.05, kinematic, seed 4 (issue 27's slip
+    ablation): adopting every stored frame at a revisit left a robot 6.56 degrees off; a
+    robot that fuses its frame with the beacon's by their variances (``fuse_frames``) ends
+    within 5 (4.15). Re-anchoring moves no robot, only its heading's label: the run is the
+    same, edge for edge."""
+    from mjswarm.experiments.embodied import EmbodiedConfig
+    from mjswarm.experiments.exploration import explore_embodied
+
+    config = EmbodiedConfig(speed_m_s=0.15, wheel_slip=0.05, physics="kinematic")
+    result = explore_embodied(load_arena("hex:3x3"), 3, config=config, seed=4)
+    assert result.completed and result.map_correct and result.collisions == 0
+    assert not result.stopped_robots
+    assert result.heading_error_deg < 5.0

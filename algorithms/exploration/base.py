@@ -76,13 +76,18 @@ class Beacon:
     ``id`` is ``None`` until the first visitor drops the beacon and names it (seed 003:
     robot R1 names its beacons a1, a2, ...; see :mod:`algorithms.exploration.beacon_ids`).
     ``data`` is whatever the strategy keeps there (for seed 003, the incidence matrix).
+    ``frame`` is what an embodied robot keeps there of the frame its stored angles are in
+    (issue 27's frame fusion): ``(offset, variance)``, how far (rad) the robots
+    believe those angles lie from the common frame and how sure (rad^2); ``None`` until
+    the robot that dropped the beacon writes it (:mod:`~algorithms.exploration.explorer`).
     """
 
-    __slots__ = ("data", "id")
+    __slots__ = ("data", "frame", "id")
 
     def __init__(self) -> None:
         self.id: str | None = None
         self.data: Any = None
+        self.frame: tuple[float, float] | None = None
 
 
 class ExpiredBeacon(RuntimeError):
@@ -133,6 +138,14 @@ class BeaconHandle:
     @data.setter
     def data(self, value: Any) -> None:
         self._beacon.data = value
+
+    @property
+    def frame(self) -> tuple[float, float] | None:
+        return self._beacon.frame
+
+    @frame.setter
+    def frame(self, value: tuple[float, float] | None) -> None:
+        self._beacon.frame = value
 
     def expire(self) -> None:
         """The tick is over: the handle no longer reaches the beacon."""

@@ -44,7 +44,14 @@ Choices beyond the paper (the loop functions in :mod:`mjswarm.experiments.explor
 * **Heading re-anchoring**: at a vertex whose beacon already stores angles
   (``Strategy.stored_angles``), the robot rotates its heading frame onto them
   (:func:`~algorithms.navigation.navigator.frame_offset`), so odometry drift does not
-  accumulate over revisits and every robot keeps the beacons' frame.
+  accumulate over revisits and every robot keeps the beacons' frame. Frame fusion
+  (issue 27): the robot that drops a beacon writes its frame's variance there
+  (``Beacon.frame``: its heading variance plus a scan's), and a robot that has found slip
+  turns only part of the way onto a stored frame, by the two variances, and moves the
+  beacon's believed offset part of the way towards its own frame
+  (:func:`~algorithms.navigation.navigator.fuse_frames`). The stored angles themselves
+  never move: they name the vertex's edges in every robot's incidence matrix, matched
+  within ``ANGLE_TOLERANCE``, and copies of them live in every matrix merged since.
 * **Stopping for good**: lost its line, no beacon where it arrived, angles that match no
   beacon, a strategy that cannot reconcile a beacon, an entry denied, a vertex it was
   granted that closed while it was on its way, a strategy that cannot route round a
@@ -101,6 +108,7 @@ from algorithms.navigation import (
     NavigatorState,
     RobotCalibration,
 )
+from algorithms.navigation.navigator import SCAN_FRAME_VAR
 from algorithms.navigation.percept import percept
 from algorithms.robot import Command, Controller, Message, Observation
 
@@ -568,7 +576,12 @@ class Explorer(Controller):
             return
         consulted = cx is None or cx.consulted
         if consulted and self.strategy.stored_angles is not None:  # re-anchoring
-            nav.reanchor(self.strategy.stored_angles)
+            nav.reanchor(self.strategy.stored_angles, beacon.frame)
+            if nav.beacon_frame is not None:
+                beacon.frame = nav.beacon_frame
+        elif self.strategy.stored_angles is None and beacon.frame is None:
+            # it dropped the beacon: its angles are in its own frame, as sure as its heading
+            beacon.frame = (0.0, nav.heading_variance + SCAN_FRAME_VAR)
         self.calls.append(VertexCall(now_s, beacon.id, arrived and not back, decision))
         mapped = tuple(self.strategy.map_edges())
         self._events.append(VertexCalled(arrived and not back, decision.action, decision.angle,

@@ -28,7 +28,10 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
   (issue 13: a lone robot's heading drifted 12 degrees over the 260 legs of
   ``lattice:10x10`` at 0.2 m/s scanning one way, 7 alternating, both before re-anchoring);
 * **re-anchoring** (:meth:`Navigator.reanchor`): at a vertex whose beacon already stores
-  angles, the caller rotates the robot's frame onto them (:func:`frame_offset`);
+  angles, the caller rotates the robot's frame onto them (:func:`frame_offset`); once the
+  robot has found slip (its odometry's distance scale), only part of the way, by the
+  weights of the two frames' variances (:func:`fuse_frames`, issue 27's
+  frame fusion);
 * **passing** (:meth:`Navigator.pass_body`, ours, issue 30): round a body that stands on
   its lane, on the opposite lane: step square across to it, follow that lane
   until it is four body radii past where the body's front was, watching the corridor
@@ -159,6 +162,15 @@ class Navigator:
         self._incoming: float | None = None
         self._scans = 0
         self._tracks: list[float] = []  # effective track estimates, one per scan (m)
+        #: the heading's variance (rad^2) at the odometry's ``wheel_sq`` of
+        #: ``_var_wheel_sq`` (:attr:`heading_variance`); 0 at the start (robots start
+        #: aligned with the common frame)
+        self._var_rad2 = 0.0
+        self._var_wheel_sq = 0.0
+        self._fused_scan = -1  # the scan whose angles it fused last
+        #: after :meth:`reanchor` fused frames: the beacon's frame ``(offset, variance)``
+        #: updated by this visit, for the caller to write back; else None
+        self.beacon_frame: tuple[float, float] | None = None
         self._lane: FollowLine | None = None
         self._left: tuple[float, float, float] | None = None  # centre x, y and angle it left by
         #: x, y and heading (odometry) where its lane ended
@@ -288,13 +300,43 @@ class Navigator:
                 on_done(motion)
         return 0.0, 0.0
 
-    def reanchor(self, stored: Sequence[float]) -> float:
+    @property
+    def heading_variance(self) -> float:
+        """Its own estimate of its heading's variance (rad^2) against the common frame:
+        what it had at its last fusion (or 0 at the start) plus what slip added since
+        (:meth:`~.odometry.Odometry.heading_variance_since`; 0 without slip found)."""
+        return self._var_rad2 + self.odometry.heading_variance_since(self._var_wheel_sq)
+
+    @property
+    def fuses_frames(self) -> bool:
+        """Whether it fuses frames at a revisit (:meth:`reanchor`): once its odometry has
+        found slip (a distance scale other than 1). Noise-free and line-noise runs never
+        find any and re-anchor fully, as before."""
+        return self.odometry.slip_sigma > 0.0
+
+    def reanchor(self, stored: Sequence[float],
+                 beacon_frame: tuple[float, float] | None = None) -> float:
         """Re-anchor the heading frame to a beacon's stored incidence angles (rad).
 
         Rotates the odometry heading, the edge angles just measured and the arrival angle
         by :func:`frame_offset` of the measured angles against ``stored``; returns that
-        rotation (rad)."""
+        rotation (rad). With ``beacon_frame`` (the beacon's ``(offset, variance)``: how
+        far its stored angles are believed to lie from the common frame, rad and rad^2)
+        and :attr:`fuses_frames`, by :func:`fuse_frames`' share of it instead: its
+        :attr:`heading_variance` shrinks accordingly, and :attr:`beacon_frame` is what the
+        caller writes back into the beacon. A robot fuses once per scan: a second call at
+        the same vertex (after idling, a queue given up) measured nothing new and turns
+        it by nothing."""
+        self.beacon_frame = None
         delta_rad = frame_offset(self.edge_angles, stored)
+        if beacon_frame is not None and self.fuses_frames:
+            if self._fused_scan == self._scans:
+                return 0.0
+            self._fused_scan = self._scans
+            delta_rad, var, offset, beacon_var = fuse_frames(
+                delta_rad, self.heading_variance, *beacon_frame)
+            self._var_rad2, self._var_wheel_sq = var, self.odometry.wheel_sq
+            self.beacon_frame = (offset, beacon_var)
         self.odometry.correct_heading(delta_rad)
         self.edge_angles = sorted((a + delta_rad) % (2.0 * math.pi) for a in self.edge_angles)
         if self.arrived_angle is not None:
@@ -600,6 +642,44 @@ class Navigator:
         self.state = NavigatorState.LOST
         self._plan.clear()
         self.events.append(NavigatorEvent(NavEvent.LOST, why))
+
+
+#: The variance (rad^2) of one vertex's frame as a scan measures it, without slip: each
+#: spoke's angle errs by about 0.9 degrees (the scan's sampling and standing off-centre;
+#: issue 27's measurements). A new beacon's frame holds its dropper's heading variance plus
+#: this; a revisit's :func:`frame_offset` errs by about as much.
+SCAN_FRAME_VAR = math.radians(0.9) ** 2
+
+
+def fuse_frames(delta_rad: float, robot_var: float, beacon_offset: float,
+                beacon_var: float) -> tuple[float, float, float, float]:
+    """A scalar Kalman update of a robot's heading and a beacon's frame on a revisit
+    (ours, issue 27's frame fusion): ``(correction, robot variance after,
+    beacon offset after, beacon variance after)``, rad and rad^2.
+
+    ``delta_rad`` is :func:`frame_offset` of the robot's measured angles onto the beacon's
+    stored ones: the beacon frame's error minus the robot's, plus a scan's error
+    (``SCAN_FRAME_VAR``). The beacon believes its frame lies ``beacon_offset`` off the
+    common frame, with variance ``beacon_var``; the robot believes its own heading
+    unbiased, with variance ``robot_var``. The innovation ``y = delta - beacon_offset``
+    has variance ``S = robot_var + beacon_var + SCAN_FRAME_VAR``:
+
+    * the robot turns by ``k y``, ``k = robot_var / S``: fully onto the beacon's frame
+      when its own heading is much less sure (the old re-anchoring, ``k = 1``), hardly at
+      all when the beacon's is (a robot fresh from the root meeting a deep vertex);
+    * the beacon's offset moves by ``(beacon_var / S) y`` towards the robot's frame, and
+      its variance shrinks alike. Its stored angles never move (they name its edges in
+      every robot's incidence matrix, matched within ``ANGLE_TOLERANCE``); the offset is
+      what a later visitor subtracts.
+
+    The two errors are taken as independent (no cross-covariance is kept): a robot back at
+    a vertex whose frame it took before shares part of its error with it, and the update
+    then trusts the pair a little too much (over issue 27's slip runs the robots' squared
+    errors average 1.3 times their variance, the beacons' 1.0 times)."""
+    s = robot_var + beacon_var + SCAN_FRAME_VAR
+    y = delta_rad - beacon_offset
+    k, kb = robot_var / s, beacon_var / s
+    return k * y, robot_var * (1.0 - k), beacon_offset + kb * y, beacon_var * (1.0 - kb)
 
 
 def frame_offset(measured: Sequence[float], stored: Sequence[float]) -> float:
