@@ -70,7 +70,7 @@ from mjswarm.experiments.bench import BENCH_SPEED_M_S
 from mjswarm.worlds.bench import bench_world
 from mjswarm.errors import MjswarmError
 from mjswarm.core.robot import ACTUATORS, LINE_SENSORS
-from mjswarm.core.simulation import Simulation
+from mjswarm.core.simulation import SENSOR_OFF, Simulation
 from mjswarm.core.world import Pose2D
 
 #: Wheel-speed difference commanded per metre of left/right line-reading difference
@@ -78,7 +78,6 @@ from mjswarm.core.world import Pose2D
 STEER_GAIN = 1000.0
 #: Replicate r runs at BENCH_SPEED_M_S * (1 - SPEED_STEP * r).
 SPEED_STEP = 0.01
-SENSOR_BIT = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
 
 
 def vertex_poses(spec: ArenaSpec, k: int) -> list[Pose2D]:
@@ -126,7 +125,7 @@ class _Replicates:
 
     def __init__(self, sim: Simulation, replicates: int) -> None:
         self.model, self.n, self.k = copy.copy(sim.model), sim.n, sim.substeps
-        self.model.opt.disableflags &= ~SENSOR_BIT
+        self.model.opt.disableflags &= ~SENSOR_OFF
         self.replicates = replicates
         ctrl = []
         for r in range(replicates):
@@ -150,19 +149,19 @@ class _Replicates:
         datas = [mujoco.MjData(m) for _ in range(self.replicates)]
         for d, u in zip(datas, self.ctrl):
             d.ctrl[:] = u
-        m.opt.disableflags |= SENSOR_BIT
+        m.opt.disableflags |= SENSOR_OFF
         start = _clock()
         for _ in range(ticks):
             for d in datas:
                 mujoco.mj_step(m, d, nstep=k)
         elapsed = _clock() - start
-        m.opt.disableflags &= ~SENSOR_BIT
+        m.opt.disableflags &= ~SENSOR_OFF
         return elapsed, datas
 
     def batch(self, ticks: int, threads: int) -> tuple[np.ndarray, mujoco.batch.Batch]:
-        self.model.opt.disableflags |= SENSOR_BIT  # the batch copies the model, flags too
+        self.model.opt.disableflags |= SENSOR_OFF  # the batch copies the model, flags too
         b = mujoco.batch.Batch(self.model, nsim=self.replicates, nthread=threads)
-        self.model.opt.disableflags &= ~SENSOR_BIT
+        self.model.opt.disableflags &= ~SENSOR_OFF
         b.ctrl = self.ctrl
         k = self.k
         start = _clock()
@@ -181,16 +180,16 @@ class _Replicates:
             for r, d in enumerate(datas):
                 self.steer(r, d.sensordata, d.ctrl)
                 if k > 1:
-                    m.opt.disableflags |= SENSOR_BIT
+                    m.opt.disableflags |= SENSOR_OFF
                     mujoco.mj_step(m, d, nstep=k - 1)
-                    m.opt.disableflags &= ~SENSOR_BIT
+                    m.opt.disableflags &= ~SENSOR_OFF
                 mujoco.mj_step(m, d)  # as Simulation.step with sensing="mujoco"
         return _clock() - start, datas
 
     def tick_batch(self, ticks: int, threads: int) -> tuple[np.ndarray, mujoco.batch.Batch]:
         b = mujoco.batch.Batch(self.model, nsim=self.replicates, nthread=threads)
         flags = b.expand("opt.disableflags")  # the batch's own copy; the model's is not read
-        on, off = flags.copy(), flags | SENSOR_BIT
+        on, off = flags.copy(), flags | SENSOR_OFF
         b.forward()
         ctrl, sensordata = b.ctrl, b.sensordata  # live views: bind once
         k = self.k

@@ -24,6 +24,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 import mujoco  # noqa: E402
 
 from mjswarm.arena import load_arena  # noqa: E402
+from mjswarm.core.simulation import SENSOR_OFF  # noqa: E402
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration  # noqa: E402
 from mjswarm.experiments.minds import make_minds  # noqa: E402
 
@@ -39,7 +40,7 @@ def bench(arena: str = "arena2", robots: int = 4, speed_m_s: float = 0.05) -> di
     steps = run.sim.data.time / run.sim.model.opt.timestep
 
     bare = EmbodiedExploration(spec, make_minds("incidence-dfs", robots), config, 0).sim
-    bare.model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+    bare.model.opt.disableflags |= SENSOR_OFF
     start = time.perf_counter()
     mujoco.mj_step(bare.model, bare.data, nstep=round(steps))
     bare_s = time.perf_counter() - start

@@ -4,15 +4,15 @@ Robot ``k`` sees robot ``p`` when a ray from ``k``'s centre at ``RAY_HEIGHT_M``,
 ``p``'s centre, hits ``p`` first; only collision geoms (``COLLISION_GROUP``: robots, walls, the floor) block.
 The bearing sensor (:mod:`mjswarm.core.bearing`) asks this for the ordered pairs in its field of
 view, the radio (:func:`mjswarm.core.radio.sight_blocker`) for every pair in range
-one way, and the way back only where the way there is clear (a link needs both).
+both ways in one call (a link needs both).
 :class:`LineOfSight` answers each ordered pair once per world state (the simulation's
 ``state_version``), so the bearing sensor's rays that the radio has already cast in a tick
-(all of them between robots that see each other, when both have the same range) cost
-nothing.
+(all of them, when the radio's range is at least the sensor's) cost nothing.
 The rays go where the simulation's rangefinders go: with ``sensing="mujoco"`` (few robots,
-below ``GRID_SENSING_MIN_ROBOTS``) to MuJoCo itself, one ``mj_multiRay`` per robot that
-looks (every ray from one robot's centre at once; 4 robots' 6 rays in about 20 us, where the
-grid caster's fixed cost is about 50 us), else to the simulation's
+below ``GRID_SENSING_MIN_ROBOTS``) to MuJoCo itself, ``mj_ray`` ray by ray below
+``MULTI_RAY_FROM`` rays, else one ``mj_multiRay`` per robot with that many (every ray from
+one robot's centre at once; 4 robots' 6 rays in about 20 us, where the grid caster's fixed
+cost is about 50 us), else to the simulation's
 :class:`~mjswarm.core.raycast.RayCaster`, which answers as ``mj_ray`` does
 (``tests/test_raycast.py`` and ``tests/test_sight.py`` check every ordered pair against
 ``mj_ray`` and the two paths against each other).

@@ -36,7 +36,7 @@ from algorithms.collision import BatchCollisionRule, CollisionRule, epsilons
 from mjswarm.core.bearing import BearingSensor
 from mjswarm.core.radio import Radio, sight_blocker
 from mjswarm.core.robot import DEFAULT_ROBOT_XML
-from mjswarm.core.simulation import Simulation
+from mjswarm.core.simulation import SENSOR_OFF, Simulation
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.bench import bench_world
 from mjswarm.worlds.loop import Loop
@@ -97,7 +97,7 @@ def run_bench(n: int, sim_seconds: float = 2.0, robot_xml: str = str(DEFAULT_ROB
     loop.step()  # warm-up: one-time costs (loading the compiled ray loop) stay out of the timing
     bare = bench_world(n, robot_xml)
     m, d = bare.model, bare.data
-    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+    m.opt.disableflags |= SENSOR_OFF
     bare.set_velocity(np.full(n, BENCH_SPEED_M_S), np.zeros(n))
 
     ticks = max(blocks, round(sim_seconds / sim.control_dt_s))
