@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 from algorithms.batch import BatchCommand, BatchController, Readings
-from algorithms.collision import BatchCollisionRule, CollisionRule
+from algorithms.batch_collision import BatchCollisionRule
+from algorithms.collision import CollisionRule
 from algorithms.navigation.percept import LINE_THRESHOLD_M
 from algorithms.robot import Command, Controller, Message, Observation
 
@@ -38,7 +39,7 @@ class BenchRobot(Controller):
 
 class BenchTeam(BatchController):
     """:class:`BenchRobot` for a whole team at once: the same commands, from arrays (the
-    speed rule over pair arrays, :class:`~algorithms.collision.BatchCollisionRule`);
+    speed rule over pair arrays, :class:`~algorithms.batch_collision.BatchCollisionRule`);
     ``heard`` counts each robot's messages (by robot id)."""
 
     def __init__(self, rule: BatchCollisionRule, line_sensor_height_m: float) -> None:

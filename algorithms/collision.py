@@ -72,9 +72,6 @@ import operator
 from collections import deque
 from dataclasses import dataclass, field
 
-import numpy as np
-
-
 #: ``S``, the initial speed of seed 003's experiments (Sec. 5: 5 cm/s), m/s: the default
 #: speed of embodied runs.
 PAPER_SPEED_M_S = 0.05
@@ -89,8 +86,6 @@ SAME_LANE_RAD = math.radians(5.0)
 #: the fewest and the most bearing samples in a rate fit (:class:`CollisionRule`)
 WINDOW = 10
 MAX_WINDOW = 80
-#: what the rule keeps per robot ``R_p`` in view (:class:`BatchCollisionRule`'s codes)
-NONE, SLOW, STOP = 0, 1, 2
 
 
 def rate_windows(window: int, max_window: int) -> tuple[int, ...]:
@@ -108,18 +103,6 @@ def slope_weights(w: int) -> tuple[tuple[float, ...], float, float]:
     t_mean = (w - 1) / 2.0
     sxx = sum((i - t_mean) ** 2 for i in range(w))
     return tuple((i - t_mean) / sxx for i in range(w)), t_mean, sxx
-
-
-def remainder_2pi(x: np.ndarray) -> np.ndarray:
-    """``math.remainder(x, 2 pi)`` elementwise, bit for bit: ``fmod`` is exact, and moving
-    its result by one period into ``[-pi, pi]`` is exact (Sterbenz); a tie (``|r| = pi``)
-    takes ``math.remainder``'s even quotient."""
-    two_pi = 2.0 * math.pi
-    r = np.fmod(x, two_pi)
-    r = np.where(r > math.pi, r - two_pi, np.where(r < -math.pi, r + two_pi, r))
-    for k in np.flatnonzero(np.abs(r) == math.pi):
-        r[k] = math.remainder(x[k], two_pi)
-    return r
 
 
 def epsilons(k: int, largest: float = 0.5, spread: float = 1.5) -> list[float]:
@@ -260,157 +243,3 @@ class CollisionRule:
         """Eq. (34): back to ``S``; pending reductions no longer apply."""
         self.speed = self.initial_speed
         self._pending.clear()
-
-
-class BatchCollisionRule:
-    """The speeds of a team of ``N`` robots under eqs. (27), (33) over pair arrays: what
-    :class:`CollisionRule` does for one robot, for all at once, with the same decisions.
-
-    State is kept per pair ``(R_k, R_p)`` in view, sorted by ``k N + p``: the bearings in
-    a ring buffer row (the last ``max_window`` samples, unwrapped), the sample count and
-    what is pending for ``R_p`` (``NONE``, ``SLOW``, ``STOP``); per robot its speed
-    ``S_k`` and its pending stops. The rate fit is :func:`slope_weights` as a dot product
-    over each window (:meth:`fit`). The speed changes of a tick are events (a reduction
-    that no longer applies, eq. 33; a new one, eq. 27) taken per robot in
-    :class:`CollisionRule`'s order (pairs that left the view, then the bearings by ``p``),
-    in rounds: the ``r``-th event of every robot at once.
-
-    The fit sums with numpy where :class:`CollisionRule` sums exactly (``math.fsum``), so
-    rates and fitted bearings agree within a few units in the last place; decisions, and
-    with them speeds, differ only where a rate lands that close to ``zero_rate`` or a
-    standard error to its bound (``tests/test_batch_team.py`` compares the two).
-    """
-
-    def __init__(self, initial_speed: float, epsilon: np.ndarray, zero_rate: float = ZERO_RATE_RAD_S,
-                 same_lane: float = SAME_LANE_RAD, window: int = WINDOW,
-                 max_window: int = MAX_WINDOW, dt: float = 0.02) -> None:
-        self.initial_speed = initial_speed
-        self.n = len(epsilon)
-        self.step = np.asarray(epsilon, float) * initial_speed  # eps_k S (m/s)
-        self.zero_rate, self.same_lane, self.dt = zero_rate, same_lane, dt
-        self.windows = rate_windows(window, max_window)
-        self.speed = np.full(self.n, float(initial_speed))
-        self.stops = np.zeros(self.n, np.int64)
-        self.key = np.empty(0, np.int64)
-        self.slot = np.empty(0, np.intp)
-        self.count = np.empty(0, np.int64)
-        self.pending = np.empty(0, np.int8)
-        self.buffer = np.empty((0, self.windows[-1]))
-        self.used = np.empty(0, bool)
-
-    def update(self, robots: np.ndarray, k: np.ndarray, p: np.ndarray,
-               beta: np.ndarray) -> np.ndarray:
-        """Take the bearings ``beta_kp`` (rad) of this tick's pairs ``(k, p)`` (sorted by
-        ``k``, then ``p``) for the robots ``robots`` stepped now; return their ``S_k`` (m/s)."""
-        if not len(k) and not len(self.key):  # nobody in view, before or now
-            return self.speed[robots]
-        key = k.astype(np.int64) * self.n + p
-        at = np.minimum(np.searchsorted(self.key, key), max(len(self.key) - 1, 0))
-        found = self.key[at] == key if len(self.key) else np.zeros(len(key), bool)
-        stepped = np.zeros(self.n, bool)
-        stepped[robots] = True
-        gone = stepped[self.key // self.n]
-        gone[at[found]] = False
-        self.used[self.slot[gone]] = False
-        left = gone & (self.pending != NONE)
-        events = [(self.key[left] // self.n, np.full(left.sum(), -1), self.pending[left])]
-        slot, count, pending = self._carry(at, found)
-        beta, count = self._record(slot, count, beta), count + 1
-        ok, rate, fitted = self.fit(slot, count)
-        beta = np.where(ok, fitted, beta)
-        off = np.abs(remainder_2pi(beta))
-        resume = (pending == STOP) & (off >= 2.0 * self.same_lane)
-        pending[resume] = NONE
-        act = (pending == NONE) & ok & (np.abs(rate) < self.zero_rate)
-        pending[act] = np.where(off[act] < self.same_lane, STOP, SLOW)
-        events += [(k[resume], 2 * p[resume], np.full(resume.sum(), STOP, np.int8)),
-                   (k[act], 2 * p[act] + 1, -pending[act])]
-        self._apply(*(np.concatenate(e) for e in zip(*events)))
-        self._keep(~stepped[self.key // self.n], key, slot, count, pending)
-        return self.speed[robots]
-
-    def _carry(self, at: np.ndarray, found: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Each current pair's buffer row, sample count and pending code (a pair new in
-        view gets a free row, no samples, nothing pending)."""
-        new = np.flatnonzero(~found)
-        free = np.flatnonzero(~self.used)
-        if len(free) < len(new):  # grow the ring buffers (at least double)
-            grow = max(len(new), len(self.used))
-            self.buffer = np.vstack([self.buffer, np.empty((grow, self.buffer.shape[1]))])
-            self.used = np.concatenate([self.used, np.zeros(grow, bool)])
-            free = np.flatnonzero(~self.used)
-        slot = np.empty(len(found), np.intp)
-        count = np.zeros(len(found), np.int64)
-        pending = np.full(len(found), NONE, np.int8)
-        old = at[found]
-        slot[found], count[found], pending[found] = self.slot[old], self.count[old], self.pending[old]
-        slot[new] = free[:len(new)]
-        self.used[slot[new]] = True
-        return slot, count, pending
-
-    def _record(self, slot: np.ndarray, count: np.ndarray, beta: np.ndarray) -> np.ndarray:
-        """Append each pair's sample to its ring buffer, unwrapped against the previous
-        one (rad); the samples as stored."""
-        size = self.buffer.shape[1]
-        seen = count > 0
-        last = self.buffer[slot[seen], (count[seen] - 1) % size]
-        beta = np.array(beta, float)
-        beta[seen] = last + remainder_2pi(beta[seen] - last)
-        self.buffer[slot, count % size] = beta
-        return beta
-
-    def fit(self, slot: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, ...]:
-        """:meth:`CollisionRule.fit` for every pair: whether a window tells, the rate
-        (rad/s) and the fitted ``beta`` now (rad), from the shortest window of the last
-        samples whose slope's standard error is at most ``zero_rate / RATE_SIGMAS``."""
-        size = self.buffer.shape[1]
-        ok = np.zeros(len(slot), bool)
-        rate, fitted = np.zeros(len(slot)), np.zeros(len(slot))
-        open_ = np.ones(len(slot), bool)
-        for w in self.windows:
-            open_ &= count >= w
-            idx = np.flatnonzero(open_)
-            if not len(idx):
-                break
-            weights, t_mean, sxx = slope_weights(w)
-            at = np.arange(w)
-            ys = self.buffer[slot[idx, None], (count[idx, None] - w + at) % size]
-            slope = ys @ np.array(weights)  # rad per tick
-            y_mean = ys.sum(axis=1) / w
-            rss = (((ys - y_mean[:, None]) - slope[:, None] * (at - t_mean)) ** 2).sum(axis=1)
-            tells = np.sqrt(rss / (w - 2) / sxx) / self.dt <= self.zero_rate / RATE_SIGMAS
-            done = idx[tells]
-            ok[done], open_[done] = True, False
-            rate[done] = slope[tells] / self.dt
-            fitted[done] = y_mean[tells] + slope[tells] * (w - 1 - t_mean)
-        return ok, rate, fitted
-
-    def _apply(self, robot: np.ndarray, order: np.ndarray, code: np.ndarray) -> None:
-        """Apply speed events in each robot's order (by ``order``), the ``r``-th event of
-        every robot in round ``r``. ``code``: a reduction for ``R_p`` that no longer
-        applies (eq. 33; ``SLOW``, ``STOP``) or a new one (eq. 27; ``-SLOW``, ``-STOP``)."""
-        if not len(robot):
-            return
-        sort = np.lexsort((order, robot))
-        robot, code = robot[sort], code[sort]
-        rank = np.arange(len(robot)) - np.searchsorted(robot, robot)
-        S = self.initial_speed
-        for r in range(int(rank.max()) + 1):
-            k, c = robot[rank == r], code[rank == r]
-            s, e = self.speed[k], self.step[k]
-            self.stops[k] += (c == -STOP).astype(np.int64) - (c == STOP)
-            pop = c > 0
-            s = np.where(pop & (s == 0.0) & (self.stops[k] == 0), S,
-                         np.where(pop & (s > 0.0), np.minimum(S, s + e), s))
-            s = np.where(c == -STOP, 0.0, np.where(c == -SLOW, np.maximum(0.0, s - e), s))
-            self.speed[k] = s
-
-    def _keep(self, stay: np.ndarray, key: np.ndarray, slot: np.ndarray, count: np.ndarray,
-              pending: np.ndarray) -> None:
-        """The pairs from now on: those of robots not stepped this tick, and this tick's."""
-        key = np.concatenate([self.key[stay], key])
-        order = np.argsort(key, kind="stable")
-        self.key = key[order]
-        self.slot = np.concatenate([self.slot[stay], slot])[order]
-        self.count = np.concatenate([self.count[stay], count])[order]
-        self.pending = np.concatenate([self.pending[stay], pending])[order]

@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from algorithms.collision import BatchCollisionRule, CollisionRule, epsilons
+from algorithms.batch_collision import BatchCollisionRule
+from algorithms.collision import CollisionRule, epsilons
 
 S = 0.05
 
@@ -198,3 +199,45 @@ def test_bench_team_commands_what_each_bench_robot_would():
             c = robot.step(readings.observation(r))
             assert (c.v_m_s, c.omega_rad_s, c.messages) == batch.command(r)
     assert team.heard.tolist() == [r.heard for r in robots]
+
+
+def test_compiled_remainder_and_fsum_are_pythons():
+    """The compiled rule's ``math.remainder(x, 2 pi)`` and ``math.fsum``, bit for bit, on
+    random values, odd multiples of pi (the ties) and sums that cancel."""
+    import math
+
+    from algorithms.batch_collision import PARTIALS, _fsum, _remainder_2pi
+
+    rng = np.random.default_rng(5)
+    xs = [*rng.normal(0, 30, 2000).tolist(), *(k * math.pi for k in range(-41, 42)),
+          *(math.pi * k + d for k in range(-9, 10, 2) for d in (-1e-15, 0.0, 1e-15))]
+    assert [_remainder_2pi(x) for x in xs] == [math.remainder(x, 2 * math.pi) for x in xs]
+    partials = np.empty(PARTIALS)
+    for _ in range(300):
+        w = int(rng.integers(1, 81))
+        v = rng.normal(0, 1, w) * 10.0 ** rng.integers(-20, 20, w)
+        v = np.concatenate([v, -v[: int(rng.integers(0, w + 1))] * (1 + 1e-16)])
+        assert _fsum(v, partials) == math.fsum(v.tolist())
+
+
+def test_batched_rule_decides_as_the_per_robot_rule_at_its_thresholds():
+    """Bearings whose fitted rate lies within a few ulps of ``zero_rate``, on and off the
+    lane: where plain sums could tip a decision, the compiled rule sums exactly, so every
+    robot's speed is its own rule's, tick by tick."""
+    from algorithms.collision import ZERO_RATE_RAD_S
+
+    n, dt = 120, 0.02
+    eps = epsilons(n)
+    rules = [CollisionRule(S, e) for e in eps]
+    batch = BatchCollisionRule(S, np.array(eps))
+    robots = np.arange(n)
+    per_tick = ZERO_RATE_RAD_S * dt * (1.0 + np.arange(-60, 60) * 2e-16)  # rad a tick
+    start = np.where(robots % 2, 0.3, 0.01) + robots * 1e-3
+    stopped = 0
+    for t in range(30):
+        beta = start + np.where(robots % 4 < 2, 1, -1) * per_tick * t
+        expected = [rules[i].update({(i + 1) % n: float(beta[i])}) for i in range(n)]
+        got = batch.update(robots, robots, (robots + 1) % n, beta)
+        assert got.tolist() == expected
+        stopped = max(stopped, sum(s < S for s in expected))
+    assert 0 < stopped < n  # both sides of the threshold are reached

@@ -10,7 +10,7 @@ robots in a grid, each on its own floor strip, walls beside every row) and measu
   bearing sensor (+-60 degrees, 1 m, line of sight), a radio (range ``RADIO_RANGE_M``,
   links need line of sight both ways) on which every robot broadcasts a heartbeat every
   tick and reads its inbox, and per robot the seed-003 speed rule
-  (:class:`~algorithms.collision.BatchCollisionRule` over pair arrays, or
+  (:class:`~algorithms.batch_collision.BatchCollisionRule` over pair arrays, or
   :class:`~algorithms.collision.CollisionRule` per robot; bearing rates) setting the speed of a
   line follower that steers from the robot's own line sensors;
 * ``physics_only_realtime_factor``: the same for bare ``mj_step`` on the same compiled
@@ -32,7 +32,8 @@ import mujoco
 import numpy as np
 
 from algorithms.bench_robot import BenchRobot, BenchTeam
-from algorithms.collision import BatchCollisionRule, CollisionRule, epsilons
+from algorithms.batch_collision import BatchCollisionRule
+from algorithms.collision import CollisionRule, epsilons
 from mjswarm.core.bearing import BearingSensor
 from mjswarm.core.radio import Radio, sight_blocker
 from mjswarm.core.robot import DEFAULT_ROBOT_XML
