@@ -267,7 +267,8 @@ def test_a_give_up_that_crosses_its_grant_leaves_the_grant_standing():
 def test_nearest_vertex_by_the_whole_matrix_equals_the_k_d_tree(monkeypatch, seed):
     """Below ``NEAREST_TREE_FROM`` robot-vertex pairs the stations find each robot's
     vertex from the whole distance matrix; the k-d tree gives the same vertices and
-    distances (robots anywhere on and off the arena, some on vertex centres)."""
+    distances (robots anywhere on and off the arena, some on vertex centres), and so
+    does each way when only some robots are on the floor (the rest asked one by one)."""
     from mjswarm.experiments import stations
 
     class Sim:  # the two things NearestVertex reads of a simulation
@@ -284,10 +285,12 @@ def test_nearest_vertex_by_the_whole_matrix_equals_the_k_d_tree(monkeypatch, see
     xy = rng.uniform(lo, hi, (40, 2))
     xy[:5] = vertices[rng.integers(len(vertices), size=5)]  # standing on centres
     answers = []
+    present = rng.random(len(xy)) < 0.5
     for tree_from in (10**9, 0):  # the matrix, then the tree
         monkeypatch.setattr(stations, "NEAREST_TREE_FROM", tree_from)
-        nearest = stations.NearestVertex(Sim(xy), spec)
-        assert (nearest._tree is None) == (tree_from > 0)
-        answers.append([nearest(i) for i in range(len(xy))])
-    assert answers[0] == answers[1]
+        for on_floor in (None, present):
+            nearest = stations.NearestVertex(Sim(xy), spec, on_floor)
+            assert (nearest._tree is None) == (tree_from > 0)
+            answers.append([nearest(i) for i in range(len(xy))])
+    assert answers[0] == answers[1] == answers[2] == answers[3]
     assert all(d == 0.0 for _, d in answers[0][:5])

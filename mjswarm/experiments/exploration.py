@@ -234,7 +234,7 @@ class EmbodiedExploration(LoopFunctions):
         tied = config.connectivity != "none"
         k = len(self.minds)
         self.roster = Roster(world.docked)
-        nearest = NearestVertex(self.sim, spec)
+        nearest = NearestVertex(self.sim, spec, world.present)
         self.beliefs = (BeliefSampling(world) if world.radio is not None and not tied
                         else None)
         self.faults = Faults(world, config.faults)

@@ -222,35 +222,47 @@ NEAREST_TREE_FROM = 4096
 
 class NearestVertex:
     """Which vertex each robot of ``sim`` is nearest to, and how far (m): what the
-    stations see. Worked out once per world state, for every robot at once, by a k-d tree
-    over the vertices (a robot-by-vertex distance matrix took 5.3 of 9.4 s of a 1000-robot
-    ``lattice:30x30`` run's first 20 s; ``tree.query`` is ``O(N log V)``), or by the
-    whole matrix below ``NEAREST_TREE_FROM`` robot-vertex pairs (the same vertices: a
-    robot exactly halfway between two is the only case the two could answer apart)."""
+    stations see. Worked out once per world state, for every robot on the floor at once
+    (``present``, the world's live mask; robots waiting in the depot are asked about
+    one by one, if ever), by a k-d tree over the vertices (a robot-by-vertex distance
+    matrix took 5.3 of 9.4 s of a 1000-robot ``lattice:30x30`` run's first 20 s;
+    ``tree.query`` is ``O(N log V)``), or by the whole matrix below ``NEAREST_TREE_FROM``
+    robot-vertex pairs (the same vertices: a robot exactly halfway between two is the
+    only case the two could answer apart)."""
 
-    def __init__(self, sim, spec: ArenaSpec) -> None:
+    def __init__(self, sim, spec: ArenaSpec, present: np.ndarray | None = None) -> None:
         self.sim = sim
         self._xy = np.array(list(spec.vertices.values()))
         self._tree = (cKDTree(self._xy) if sim.n * len(self._xy) >= NEAREST_TREE_FROM
                       else None)
         self._ids = list(spec.vertices)
+        self._present = np.ones(sim.n, bool) if present is None else present
         self._version = -1
-        self._nearest = self._distance = None
+        self._nearest: list = []
+        self._distance: list = []
 
     def __call__(self, i: int) -> tuple[str, float]:
         sim = self.sim
         if self._version != sim.state_version:
-            xy = sim.poses()[:, :2]
-            if self._tree is not None:
-                self._nearest = self._tree.query(xy)[1]
-            else:
-                gap = xy[:, None, :] - self._xy[None, :, :]
-                self._nearest = np.einsum("nvk,nvk->nv", gap, gap).argmin(axis=1)
-            v = self._xy[self._nearest]
-            distance = np.hypot(xy[:, 0] - v[:, 0], xy[:, 1] - v[:, 1])
-            self._nearest, self._distance = self._nearest.tolist(), distance.tolist()
+            rows = np.flatnonzero(self._present)
+            nearest, distance = np.zeros(sim.n, np.intp), np.full(sim.n, np.nan)
+            nearest[rows], distance[rows] = self._find(sim.poses()[rows, :2])
+            self._nearest, self._distance = nearest.tolist(), distance.tolist()
             self._version = sim.state_version
+        if not self._present[i]:  # in the depot: asked alone
+            (v,), (d,) = self._find(sim.poses()[i:i + 1, :2])
+            return self._ids[v], float(d)
         return self._ids[self._nearest[i]], self._distance[i]
+
+    def _find(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The nearest vertex of each point ``xy`` (m), by index, and its distance (m)."""
+        if self._tree is not None:
+            nearest = self._tree.query(xy)[1]
+        else:
+            gap = xy[:, None, :] - self._xy[None, :, :]
+            nearest = np.einsum("nvk,nvk->nv", gap, gap).argmin(axis=1)
+        v = self._xy[nearest]
+        return nearest, np.hypot(xy[:, 0] - v[:, 0], xy[:, 1] - v[:, 1])
 
 
 class StationService(LoopFunctions):
