@@ -56,8 +56,31 @@ def test_a_strip_is_seen_as_one_run_with_its_lag():
     falls = [i for i in range(1, len(centre)) if centre[i - 1] and not centre[i]]
     assert len(rises) == len(falls) == 1
     lag = out[rises[0]][1]
-    assert lag == 3  # window 7 at 0.5 mm (5 sigmas: 6.25 readings)
+    # window 7 at 0.5 mm (5 sigmas: 6.25 readings), or 9 once the estimate has been over
+    # 7's limit (0.53 mm) and not since 10 % below it
+    assert lag in (3, 4)
     assert abs(rises[0] - lag - 200) <= 2 and abs(falls[0] - lag - 230) <= 2
+
+
+def strip_crossings(sigma: float, seed: int, strips: int = 80) -> int:
+    """How many times the centre sensor turns on over ``strips`` strips (12 ticks each,
+    25 of floor between) read with noise ``sigma`` (m)."""
+    rng = np.random.default_rng(seed)
+    flt = LineFilter(FLOOR_M)
+    truth = [False] * 100 + ([True] * 12 + [False] * 25) * strips
+    centre = [flt(SUNK_M - (STRIP_M if on else 0.0) + rng.normal(0.0, sigma, 3))[0][1]
+              for on in truth]
+    return sum(b and not a for a, b in zip(centre, centre[1:]))
+
+
+def test_a_noise_at_a_window_limit_sees_each_strip_once():
+    """Noises at a window's limit (0.5 and 0.54 mm about 7 readings' 0.53 mm, 0.33 mm
+    about 5 readings' 0.32 mm) move the estimate across the limit again and again; a
+    window that followed it tick by tick changed its mean and lag mid-strip and saw 3
+    strips twice in these 1440 (a robot took its new lane for ended). The window now
+    shrinks only with ``WINDOW_HYSTERESIS`` to spare: each strip once."""
+    assert all(strip_crossings(sigma, seed) == 80 for sigma in (0.0005, 0.00054, 0.00033)
+               for seed in range(6))
 
 
 def test_noise_free_readings_pass_unfiltered():
@@ -148,7 +171,8 @@ def test_a_scan_off_the_centre_tells_spokes_45_degrees_apart_under_noise():
         merged += len(one_per_run.mids) < len(spokes)
         scan = scan_spokes(spokes, 0.0005, seed, SPOKE_WIDTH / 2, spoke_width=SPOKE_WIDTH,
                            off_m=off, direction=-1)
-        assert scan.full_turn == pytest.approx(2 * math.pi, abs=math.radians(2))
+        # one scan's full turn spreads about a degree here (the worst of 60 seeds: 2.7)
+        assert scan.full_turn == pytest.approx(2 * math.pi, abs=math.radians(3))
         found = off_centre_correction([m % (2 * math.pi) for m in scan.mids], incoming, 0.05)
         assert [math.degrees(a) for a in found] == pytest.approx(spokes, abs=2.5)
     assert merged >= 4  # teeth

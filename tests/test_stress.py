@@ -158,6 +158,10 @@ def test_a_lone_robot_keeps_its_heading_over_384_legs():
     # line noise 0.5 mm, 45 degree junction: leaving r3, the left sensor found the corner
     # of the neighbouring edge's lane first and the robot followed it (lost)
     StressRun("wheel:4@8", 1, 0.1, 0, Noise(line_m=0.0005), "kinematic"),
+    # every noise, 0.1 m/s: leaving v3, R4's line window went 7, 9, 7, 9 tick by tick (its
+    # noise estimate at 7's limit), its new lane's centre turned on and off, and it took
+    # the lane for ended (lost at 218.3 s, four edges unreachable)
+    StressRun("random-planar:8:1", 4, 0.1, 0, NOISES[-1], "kinematic"),
 ], ids=str)
 def test_noise_representatives(run):
     result = run.run(max_sim_time_s=1200.0)
