@@ -50,17 +50,17 @@ def bench(arena: str = "arena2", robots: int = 4, speed_m_s: float = 0.05) -> di
             "bare_realtime": result.sim_time_s / bare_s, "overhead_ratio": full_s / bare_s}
 
 
-def main_job_arguments(doc: str) -> argparse.Namespace:
+def main_job_parser(doc: str) -> argparse.ArgumentParser:
     """The command line of a benchmark of one exploration: arena, robots, speed (m/s)."""
     parser = argparse.ArgumentParser(description=doc.splitlines()[0])
     parser.add_argument("--arena", default="arena2")
     parser.add_argument("--robots", type=int, default=4)
     parser.add_argument("--speed", type=float, default=0.05, help="m/s (default 0.05)")
-    return parser.parse_args()
+    return parser
 
 
 if __name__ == "__main__":
-    args = main_job_arguments(__doc__)
+    args = main_job_parser(__doc__).parse_args()
     r = bench(args.arena, args.robots, args.speed)
     print(f"machine: {platform.machine()}, Python {platform.python_version()}, "
           f"MuJoCo {mujoco.__version__}")

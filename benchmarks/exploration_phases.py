@@ -9,6 +9,11 @@ so the phases add up to a little more than an untimed run; compare them with eac
 and with ``mj_step``, not with ``benchmarks/exploration_bench.py``.
 
     python benchmarks/exploration_phases.py [--arena arena2] [--robots 4] [--speed 0.05]
+        [--physics dynamic|kinematic] [--max-time S]
+
+``--physics kinematic --max-time S`` profiles the first S simulated seconds of a big
+swarm's run, e.g. ``--arena lattice:30x30 --robots 1000 --speed 0.2 --physics kinematic
+--max-time 300`` (the strategies seeded with 0, as ``mjswarm explore --seed 0``).
 """
 
 from __future__ import annotations
@@ -23,7 +28,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 import mujoco  # noqa: E402
 
-from benchmarks.exploration_bench import main_job_arguments  # noqa: E402
+from benchmarks.exploration_bench import main_job_parser  # noqa: E402
 from mjswarm.arena import load_arena  # noqa: E402
 from mjswarm.core import simulation  # noqa: E402
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration  # noqa: E402
@@ -44,10 +49,14 @@ def timed(spent: Counter, phase: str, function):
     return wrapper
 
 
-def phases(arena: str, robots: int, speed_m_s: float) -> tuple[Counter, int, float]:
-    """Each phase's wall time (s), the control ticks and the whole run's wall time (s)."""
-    run = EmbodiedExploration(load_arena(arena), make_minds("incidence-dfs", robots),
-                              EmbodiedConfig(speed_m_s=speed_m_s), 0)
+def phases(arena: str, robots: int, speed_m_s: float, physics: str = "dynamic",
+           max_time_s: float | None = None) -> tuple[Counter, int, float]:
+    """Each phase's wall time (s), the control ticks and the whole run's wall time (s):
+    the whole run, or its first ``max_time_s`` simulated seconds."""
+    until = {} if max_time_s is None else {"max_sim_time_s": max_time_s}
+    config = EmbodiedConfig(speed_m_s=speed_m_s, physics=physics, **until)
+    minds = make_minds("incidence-dfs", robots, None if max_time_s is None else 0)
+    run = EmbodiedExploration(load_arena(arena), minds, config, 0)
     spent: Counter = Counter()
     world = run.world
     world.observe = timed(spent, PHASES[1], world.observe)
@@ -69,8 +78,13 @@ def phases(arena: str, robots: int, speed_m_s: float) -> tuple[Counter, int, flo
 
 
 if __name__ == "__main__":
-    args = main_job_arguments(__doc__)
-    spent, ticks, wall_s = phases(args.arena, args.robots, args.speed)
+    parser = main_job_parser(__doc__)
+    parser.add_argument("--physics", choices=("dynamic", "kinematic"), default="dynamic")
+    parser.add_argument("--max-time", type=float, default=None, metavar="S",
+                        help="stop after S simulated seconds (default: the whole run)")
+    args = parser.parse_args()
+    spent, ticks, wall_s = phases(args.arena, args.robots, args.speed, args.physics,
+                                  args.max_time)
     print(f"{args.arena}, {args.robots} robots: {ticks} control ticks, "
           f"{wall_s / ticks * 1e6:.0f} us a tick in all")
     for phase in PHASES:

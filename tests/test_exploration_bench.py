@@ -29,3 +29,15 @@ def test_embodied_bench_compares_the_loop_with_bare_physics_of_the_same_run():
     assert r["completed"] and r["sim_time_s"] > 10
     assert r["bare_realtime"] > r["full_realtime"] > 0
     assert r["overhead_ratio"] == r["full_wall_s"] / r["bare_wall_s"]
+
+
+def test_phase_benchmarks_time_every_phase_of_a_short_run():
+    """``bench_phases`` and ``exploration_phases`` (a big swarm's first seconds): every
+    phase they name is timed, and the phases fit inside the run's wall time."""
+    spent, full_s, bare_s = load_bench("bench_phases").phases(3, 20, "kinematic")
+    names = load_bench("bench_phases").PHASES
+    assert all(spent[p] > 0 for p in names) and bare_s > 0
+    assert spent[names[4]] < full_s
+    explore = load_bench("exploration_phases")
+    spent, ticks, wall_s = explore.phases("fig9", 2, 0.2, "kinematic", max_time_s=2.0)
+    assert ticks == 100 and 0 < spent["controllers"] < wall_s
