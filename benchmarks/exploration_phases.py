@@ -9,11 +9,12 @@ so the phases add up to a little more than an untimed run; compare them with eac
 and with ``mj_step``, not with ``benchmarks/exploration_bench.py``.
 
     python benchmarks/exploration_phases.py [--arena arena2] [--robots 4] [--speed 0.05]
-        [--physics dynamic|kinematic] [--max-time S]
+        [--physics dynamic|kinematic] [--max-time S] [--seed S]
 
 ``--physics kinematic --max-time S`` profiles the first S simulated seconds of a big
 swarm's run, e.g. ``--arena lattice:30x30 --robots 1000 --speed 0.2 --physics kinematic
---max-time 300`` (the strategies seeded with 0, as ``mjswarm explore --seed 0``).
+--max-time 300 --seed 0`` (``--seed``: the strategies' seed, as ``mjswarm explore
+--seed``; by default unseeded, as ``benchmarks/exploration_bench.py``).
 """
 
 from __future__ import annotations
@@ -50,13 +51,13 @@ def timed(spent: Counter, phase: str, function):
 
 
 def phases(arena: str, robots: int, speed_m_s: float, physics: str = "dynamic",
-           max_time_s: float | None = None) -> tuple[Counter, int, float]:
+           max_time_s: float | None = None, seed: int | None = None) -> tuple[Counter, int, float]:
     """Each phase's wall time (s), the control ticks and the whole run's wall time (s):
     the whole run, or its first ``max_time_s`` simulated seconds."""
     until = {} if max_time_s is None else {"max_sim_time_s": max_time_s}
     config = EmbodiedConfig(speed_m_s=speed_m_s, physics=physics, **until)
-    minds = make_minds("incidence-dfs", robots, None if max_time_s is None else 0)
-    run = EmbodiedExploration(load_arena(arena), minds, config, 0)
+    run = EmbodiedExploration(load_arena(arena), make_minds("incidence-dfs", robots, seed),
+                              config, 0)
     spent: Counter = Counter()
     world = run.world
     world.observe = timed(spent, PHASES[1], world.observe)
@@ -82,9 +83,11 @@ if __name__ == "__main__":
     parser.add_argument("--physics", choices=("dynamic", "kinematic"), default="dynamic")
     parser.add_argument("--max-time", type=float, default=None, metavar="S",
                         help="stop after S simulated seconds (default: the whole run)")
+    parser.add_argument("--seed", type=int, default=None,
+                        help="the strategies' seed (default: none, as the main job's bench)")
     args = parser.parse_args()
     spent, ticks, wall_s = phases(args.arena, args.robots, args.speed, args.physics,
-                                  args.max_time)
+                                  args.max_time, args.seed)
     print(f"{args.arena}, {args.robots} robots: {ticks} control ticks, "
           f"{wall_s / ticks * 1e6:.0f} us a tick in all")
     for phase in PHASES:

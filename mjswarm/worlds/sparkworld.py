@@ -93,7 +93,11 @@ class SparkWorld(World):
 
     def active(self) -> list[int]:
         """The robots on the floor and switched on."""
-        return np.flatnonzero(self.present & self.powered).tolist()
+        return self._active_rows().tolist()
+
+    def _active_rows(self) -> np.ndarray:
+        """:meth:`active` as an index array."""
+        return np.flatnonzero(self.present & self.powered)
 
     @property
     def nodes(self) -> list:
@@ -109,7 +113,7 @@ class SparkWorld(World):
             return Observation(i, self.sim.time_s, inbox=inbox, neighbors=neighbors)
         r = self._sense()
         if not self._columns:  # one conversion of the active robots' records per state
-            rows = np.flatnonzero(self.present & self.powered)
+            rows = self._active_rows()
             whole = len(rows) == self.n
             self._row = None if whole else dict(zip(rows.tolist(), range(len(rows))))
             self._columns = self._as_lists(r if whole else r[rows])
