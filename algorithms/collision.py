@@ -31,7 +31,7 @@ Choices where the paper is silent (see also :class:`CollisionRule`):
   ahead (``|beta| >= 2 same_lane``): on collinear edges a robot that went on and came back
   on the other lane stays in view, and waiting for it to leave the view deadlocks.
 
-Noisy bearings (issue 27; the paper's sensor is exact). Each bearing carries Gaussian
+Noisy bearings (ours: the paper's sensor is exact). Each bearing carries Gaussian
 noise of standard deviation ``sigma``; the rule does not need to be told ``sigma``: the
 residuals of its own fit estimate it. Over ``W`` samples ``dt`` apart the fitted slope's
 standard error is ``sigma sqrt(12 / (W (W^2 - 1))) / dt``; the rule decides only with the

@@ -1,4 +1,4 @@
-"""Does ``mujoco.batch`` help replicate embodied runs? (issue 8, part 3)
+"""Does ``mujoco.batch`` help replicate embodied runs?
 
 For one world and R replicate simulations of it, measures physics throughput in
 simulated robot-seconds per wall second (R replicates x N robots x simulated seconds /

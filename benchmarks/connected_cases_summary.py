@@ -1,4 +1,4 @@
-"""Issue 17's random cases in one line per constraint: completions and total makespan.
+"""Connected exploration's random cases in one line per constraint: completions and total makespan.
 
 Runs the graph-world cases of ``tests/test_connected_exploration.py`` (``CASES``: random
 graphs and trees, 2 to 6 robots, ranges 0.7 to 2.5 m) under ``connected`` and

@@ -1,4 +1,4 @@
-"""Issue 17's embodied table: exploration that stays connected on the MuJoCo robots.
+"""The embodied table of exploration that stays connected on the MuJoCo robots.
 
 Each case (arena, team size K, radio range R in m, speed in m/s, seed, constraint) is one
 run of :func:`mjswarm.experiments.exploration.explore_embodied` (incidence-DFS,

@@ -1,4 +1,4 @@
-"""Issue 17's table: the price of staying connected, in the graph world.
+"""The connected-exploration table: the price of staying connected, in the graph world.
 
 For each arena, team size K and radio range R (m), one run per constraint (``none``,
 ``connected``, ``biconnected``; seed 003's incidence-DFS, canonical tie rules) in

@@ -5,7 +5,7 @@ paper's 5 cm/s), then steps a fresh copy of the same compiled world with bare
 ``mj_step`` (sensors off, the robots standing in the depot and on the root as at the
 start, constant controls) for as many physics steps, and prints both rates and their
 quotient: how many times longer the full loop (sensing, bearings, controllers, stations,
-radio) takes than the physics alone. Issue 16 asks for at most 1.3 on the main job.
+radio) takes than the physics alone. The target is at most 1.3 on the main job.
 
     python benchmarks/exploration_bench.py [--arena arena2] [--robots 4] [--speed 0.05]
 """

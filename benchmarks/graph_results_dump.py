@@ -1,5 +1,5 @@
 """Dump the graph worlds' results on a large grid, to check that a change to the graph
-worlds or the loop leaves them identical (issue 28).
+worlds or the loop leaves them identical.
 
     python benchmarks/graph_results_dump.py OUT.jsonl      # about 2 minutes on 2 cores
     python benchmarks/graph_results_dump.py NEW.jsonl && cmp OLD.jsonl NEW.jsonl

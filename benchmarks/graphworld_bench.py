@@ -1,4 +1,4 @@
-"""Graph-world speed: exploration runs per second on one core (issue 16; target >= 1000 runs/s
+"""Graph-world speed: exploration runs per second on one core (target >= 1000 runs/s
 for ``lattice:10x10`` with 10 robots and the proposed strategy).
 
 Run ``python benchmarks/graphworld_bench.py`` from the repository root, or call

@@ -1,4 +1,4 @@
-"""Bare ``mj_step`` speed of the bench world under physics variants (issue 8).
+"""Bare ``mj_step`` speed of the bench world under physics variants.
 
 Answers "how fast could the physics itself go?" for N robots driving straight:
 
@@ -12,7 +12,7 @@ Answers "how fast could the physics itself go?" for N robots driving straight:
 * ``ellipsoid+4ms+cg+islands-off``: the same with one monolithic solve.
 
 Prints real-time factor, milliseconds per physics step, contacts per robot and mean speed
-per variant. None of these is shipped (README, "Benchmark", says why): ``islands-off``
+per variant. None of these is shipped (``docs/performance.md`` says why): ``islands-off``
 changes multi-robot trajectories (no longer bit-identical), so every embodied figure
 would need re-measuring, and the faster ones make the navigator's odometry drift past the bounds of
 ``tests/test_navigation.py``.

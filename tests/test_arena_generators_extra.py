@@ -1,4 +1,4 @@
-"""Arena generators beyond the square lattice, and rotation (issue 13's stress grid)."""
+"""Arena generators beyond the square lattice, and rotation (the arenas of the stress grid)."""
 
 from __future__ import annotations
 

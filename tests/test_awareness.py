@@ -1,4 +1,4 @@
-"""Connectivity awareness on moving embodied robots (issue 6 part 4): tables kept up to
+"""Connectivity awareness on moving embodied robots: tables kept up to
 date over the radio while robots explore, checked against networkx on ground truth."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 18: a user's output files are never lost, every option is checked before any
+"""A user's output files are never lost, every option is checked before any
 output is opened, options that would be ignored are errors, and runs say what they do."""
 
 from __future__ import annotations
@@ -50,7 +50,7 @@ def test_an_interrupted_run_keeps_a_valid_partial_recording(tmp_path, capsys, mo
     assert main(["explore", "--arena", "arena1", "--robots", "2", "--record",
                  str(target)]) == 130
     err = capsys.readouterr().err
-    partial = tmp_path / "run.partial.rrd"  # beside the user's earlier file (issue 26)
+    partial = tmp_path / "run.partial.rrd"  # beside the user's earlier file
     assert "interrupted; partial output kept" in err and str(partial) in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.partial.rrd", "run.rrd"]
     assert target.read_bytes() == b"old"

@@ -1,4 +1,4 @@
-"""Closed vertices (issue 30, item 3): a body stopped for good in a vertex area closes
+"""Closed vertices: a body stopped for good in a vertex area closes
 that vertex; the team finishes every edge it can still reach, declares completion of that
 part (Theorem 1 on the reach, :mod:`algorithms.exploration.incidence_matrix`) and the
 result names the edges it could not reach.
@@ -361,9 +361,9 @@ def test_embodied_robot_cut_off_by_a_closed_root_finishes_its_part():
 def test_a_body_where_corridors_still_meet_closes_the_vertex():
     """wheel:6, 3 robots at 0.15 m/s (kinematic): R3 fails at 76 s on its spoke 0.28 m from
     rim vertex r5, beyond r5's area but where the spoke's corridor still meets the rim's
-    (they meet at 60 degrees: the walls start 0.38 m out, ``junction_depths``). Before,
-    R1 drove along the rim into the body (1 contact) and the run stalled; now the body
-    closes r5 and the team completes the reachable part with no contact."""
+    (they meet at 60 degrees: the walls start 0.38 m out, ``junction_depths``). The body
+    closes r5 (else R1 would drive along the rim into it), and the team completes the
+    reachable part with no contact."""
     from mjswarm.arena.geometry import VERTEX_CLEAR_RADIUS_M, junction_depths
     from mjswarm.experiments.embodied import EmbodiedConfig
     from mjswarm.experiments.exploration import explore_embodied

@@ -1,4 +1,4 @@
-"""Exploration that stays connected (issue 17): the tether rules, the radio graph world's
+"""Exploration that stays connected: the tether rules, the radio graph world's
 ground-truth check, infeasibility, and the CLI."""
 
 from __future__ import annotations
@@ -121,8 +121,8 @@ def test_a_robot_paused_between_moves_does_not_say_it_stands_still():
 
 
 def test_rule_6_waits_keep_their_meaning_at_any_control_rate():
-    """The waits are time units: the graph world's 10 ticks per unit gives the same ticks
-    as before they were units, and a MuJoCo run's rate scales them."""
+    """The waits are time units: the graph world's 10 ticks per unit gives the rule's
+    waits in ticks (10, 40, 10, 40, 50, 50), and a MuJoCo run's rate scales them."""
     assert Waits.at(10) == Waits(10, 40, 10, 40, 50, 50)
     assert Waits.at(500) == Waits(500, 2000, 500, 2000, 2500, 2500)
 
@@ -334,8 +334,7 @@ def test_embodied_with_range_to_spare_changes_nothing():
 
 def test_embodied_team_completes_a_map_that_needs_a_robot_standing_between():
     """arena1, 3 robots at 2.5 m, 10 cm/s, seed 5: v8 lies 2.7 m from the base, so a robot
-    must stand between (before session 8 the team declared itself infeasible with 8 of 9
-    edges explored). It completes the true map, with 0 contacts and every robot linked
+    must stand between. It completes the true map, with 0 contacts and every robot linked
     to the base in every tick."""
     result = embodied("arena1", 3, 2.5, seed=5, speed_m_s=0.1)
     assert result.completed and result.map_correct and not result.infeasible
@@ -344,9 +343,7 @@ def test_embodied_team_completes_a_map_that_needs_a_robot_standing_between():
 
 def test_embodied_biconnected_team_completes_with_its_first_robot_docked():
     """arena1, 3 robots at 3 m, 10 cm/s: R1 docks at the base (rule 1), R2 and R3 explore
-    the true map with two disjoint routes to the base in every tick and 0 contacts. (Before
-    the dock, R1 stood on the first edge for good and the team declared itself
-    infeasible at 1 of 9 edges.)"""
+    the true map with two disjoint routes to the base in every tick and 0 contacts."""
     result = embodied("arena1", 3, 3.0, seed=0, connectivity="biconnected", speed_m_s=0.1)
     assert result.completed and result.map_correct and not result.infeasible
     assert result.paths[0] == [result.root]  # docked: it never left
@@ -358,8 +355,8 @@ def test_embodied_biconnected_team_completes_with_its_first_robot_docked():
 def test_embodied_biconnected_team_reports_when_its_docked_robot_fails():
     """R1, docked at the base, fails at 5 s: the two explorers have lost a parent and
     cannot be each other's second parent (rule 1 orders parents), so they stand, and the
-    team declares itself infeasible (rule 5, at 345 s) instead of standing until the time
-    limit (3600 s), as it did before session 9."""
+    team declares itself infeasible (rule 5, at 345 s) well before the time limit
+    (3600 s)."""
     from mjswarm.experiments.faults import RobotFailure
 
     result = embodied("arena1", 3, 3.0, seed=0, connectivity="biconnected", speed_m_s=0.1,

@@ -1,4 +1,4 @@
-"""The creep (issue 30): a robot the speed rule has held still on its lane for a long
+"""The creep (ours): a robot the speed rule has held still on its lane for a long
 time creeps on, guarded by its front IR; and a robot waiting at its wall's end for the
 vertex ahead backs off (algorithms/exploration/explorer.py)."""
 
@@ -52,9 +52,9 @@ def test_a_long_stop_creeps_on_while_the_front_is_clear_and_stops_for_a_body(rob
 
 
 def test_the_phantom_wait_of_a_dense_team_ends():
-    """``lattice:6x6``, 8 robots, 0.15 m/s, seed 1 stalled: a robot on its lane held by
-    the rule for one standing on the vertex beyond the next, which waited for the vertex
-    the first held (stations' docstring)."""
+    """``lattice:6x6``, 8 robots, 0.15 m/s, seed 1 stalls without the creep: a robot on its
+    lane is held by the rule for one standing on the vertex beyond the next, which waits
+    for the vertex the first holds (stations' docstring)."""
     result = StressRun("lattice:6x6", 8, 0.15, 1).run(max_sim_time_s=1500.0)
     assert passed(result), (result.ended_because, result.collisions, result.stopped_robots)
 

@@ -1,4 +1,4 @@
-"""Embodied exploration (issue 5): the graph strategies on MuJoCo robots with their own
+"""Embodied exploration: the graph strategies on MuJoCo robots with their own
 sensors and seed 003's collision rule. Fast checks by default; the 20-scenario sweeps
 (with and without collision avoidance) are marked slow."""
 
@@ -129,7 +129,7 @@ def test_cli_embodied_bad_input_is_one_line(capsys, argv, message):
 
 
 def test_vertex_entry_is_a_counted_exchange_with_the_stations():
-    """Every departure is a request, a grant and a 'left' (issue 14), plus at most one
+    """Every departure is a request, a grant and a 'left', plus at most one
     'clear' each; each robot may be on one more edge than it finished when the run ends."""
     result = explore_embodied(load_arena("arena1"), 2, seed=0)
     assert result.completed and result.collisions == 0

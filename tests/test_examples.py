@@ -1,4 +1,4 @@
-"""Every script in examples/ runs, and says what it should (issue 14, part 4)."""
+"""Every script in examples/ runs, and says what it should."""
 
 from __future__ import annotations
 
@@ -46,8 +46,8 @@ def test_an_experiment_run_from_python_is_plotted(tmp_path, suffix):
 
 
 def test_examples_run_from_any_directory_and_write_where_they_say(tmp_path):
-    """Issue 26: from another directory the default output goes to the repository's
-    recordings/ folder (it used to fail, or litter the working directory)."""
+    """From another directory the default output goes to the repository's recordings/
+    folder (neither a failure nor a file in the working directory)."""
     target = EXAMPLES.parent / "recordings" / "coverage.png"
     existed = target.exists()
     before = target.stat().st_mtime_ns if existed else None

@@ -137,7 +137,7 @@ def test_literal_reselection_breaks_proposition_2_on_a_star():
 def test_lattice_4x4_five_robots_proposed_beats_mr_dfs(root):
     """Seed 003 section 6: 11 (proposed) vs 16 (MR-DFS); the paper does not say where the
     robots start: the corner v0_0 and the boundary vertex next to it, v0_1. MR-DFS records
-    simultaneous arrivals before anyone decides (issue 16); an independent implementation
+    simultaneous arrivals before anyone decides; an independent implementation
     of that model gets 20 from the corner, as ours does."""
     g = lattice(4, 4)
     ours = explore(g, root, 5).makespan

@@ -134,7 +134,7 @@ def test_lattice_ten_by_ten_all_strategies_complete():
 
 
 def test_a_users_controller_runs_in_the_graph_world():
-    """Issue 28: any controller written against Observation and Command runs in the graph
+    """Any controller written against Observation and Command runs in the graph
     world (here: always the smallest incidence angle, declaring after five calls)."""
     from algorithms.exploration.events import Declared
     from algorithms.robot import Command, Controller

@@ -1,4 +1,4 @@
-"""Fault injection (issue 13): parsing, and what each fault does to an embodied run."""
+"""Fault injection: parsing, and what each fault does to an embodied run."""
 
 from __future__ import annotations
 
@@ -68,7 +68,7 @@ def test_a_dead_robot_stops_and_the_others_finish_with_the_true_map():
 
 
 def test_a_body_in_a_vertex_area_closes_it_and_the_reachable_part_is_completed():
-    """R2 dies in the area of v2 (it ended ``stalled`` before issue 30): v2 is closed, R1
+    """R2 dies in the area of v2: v2 is closed (the run does not stall), R1
     is answered EntryBlocked when it asks for it, finishes the rest and declares completion
     of the reachable part, naming the two edges at v2."""
     config = EmbodiedConfig(speed_m_s=0.1, faults=[parse_fault("robot:2@45")],

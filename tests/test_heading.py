@@ -1,4 +1,4 @@
-"""Heading re-anchoring and scan direction (issue 13): the pure pieces, checked against
+"""Heading re-anchoring and scan direction: the pure pieces, checked against
 brute force and ground truth."""
 
 from __future__ import annotations
@@ -46,9 +46,9 @@ def test_frame_offset_recovers_the_rotation(seed):
 
 
 def test_frame_fusion_weighs_the_two_frames_by_their_variances():
-    """fuse_frames (issue 27's frame fusion): a robot as sure as the truth keeps its
+    """fuse_frames (frame fusion): a robot as sure as the truth keeps its
     heading and moves the beacon's offset all the way; one much less sure than the beacon
-    adopts the beacon's frame (the old re-anchoring); equal variances split the offset."""
+    adopts the beacon's frame (plain re-anchoring); equal variances split the offset."""
     d = math.radians(4.0)
     keep, var, offset, bvar = fuse_frames(d, 0.0, 0.0, math.radians(3.0) ** 2)
     assert keep == 0.0 and var == 0.0
@@ -67,7 +67,7 @@ def test_frame_fusion_weighs_the_two_frames_by_their_variances():
 def test_the_slip_a_robot_finds_sets_its_heading_variance():
     """Odometry.slip_sigma from the calibrated distance scale (0.8 S at slip S), and the
     heading variance it adds per wheel turn; none without slip found (so noise-free runs
-    re-anchor fully, as before)."""
+    re-anchor fully)."""
     from algorithms.navigation.odometry import Odometry, RobotCalibration
     odo = Odometry(RobotCalibration(wheel_radius_m=0.03, track_m=0.1, line_ahead_m=0.05,
                                     max_speed_m_s=0.2))
@@ -190,9 +190,9 @@ def test_a_lone_robot_under_line_noise_keeps_its_heading():
 
 
 def test_frame_fusion_keeps_a_slipping_teams_heading():
-    """``hex:3x3``, 3 robots at 0.15 m/s, slip 0.05, kinematic, seed 4 (issue 27's slip
-    ablation): adopting every stored frame at a revisit left a robot 6.56 degrees off; a
-    robot that fuses its frame with the beacon's by their variances (``fuse_frames``) ends
+    """``hex:3x3``, 3 robots at 0.15 m/s, slip 0.05, kinematic, seed 4 (a slip
+    ablation): adopting every stored frame at a revisit leaves a robot more than 5 degrees
+    off; a robot that fuses its frame with the beacon's by their variances (``fuse_frames``) ends
     within 5 (4.15). Re-anchoring moves no robot, only its heading's label: the run is the
     same, edge for edge."""
     from mjswarm.experiments.embodied import EmbodiedConfig

@@ -1,4 +1,4 @@
-"""Hygiene that the types enforce (issue 28, item 4): nothing a robot observes or hears
+"""Hygiene that the types enforce: nothing a robot observes or hears
 reaches the world's ground truth. Every Observation handed out and every Message
 delivered in a short run of each experiment is walked (attributes and containers, to a
 bounded depth) and must not reference a World, a Simulation, a beacon store (a dict of
@@ -233,7 +233,7 @@ def test_a_sealed_controller_refuses_its_attributes():
 def test_the_patrol_experimenter_talks_to_robots_only_through_the_protocol(watched,
                                                                            monkeypatch):
     """Targets go to the base station as messages, roles and connections come back as
-    signals and events (issue 28, items 3 and 4): the mission runs on sealed robots."""
+    signals and events: the mission runs on sealed robots."""
     from algorithms.maintenance.roles import RoleSwitchingRobot
     from mjswarm.experiments import patrol
 

@@ -1,4 +1,4 @@
-"""The kinematic tier (issue 16): fidelity to the dynamic tier, the contact rule,
+"""The kinematic tier: fidelity to the dynamic tier, the contact rule,
 determinism and bad input. The covering walk of fig9 and the shipped figures (arena1 with
 two robots, the main job) in both tiers are slow; the lap of arena1 is their fast
 representative."""

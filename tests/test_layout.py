@@ -49,7 +49,7 @@ def _mjswarm_imports(path: Path) -> list[str]:
 
 
 def test_mjswarm_layers_import_downwards_only():
-    """Issue 28: core, then worlds, then experiments and outputs side by side, then the
+    """Core, then worlds, then experiments and outputs side by side, then the
     CLI; the layer of a module is its first package under mjswarm/."""
     root = Path(algorithms.__file__).resolve().parents[1] / "mjswarm"
     bad = []

@@ -156,7 +156,7 @@ def test_leaving_a_vertex_takes_its_own_lane_not_the_corner_of_a_neighbours():
     """Edges 45 degrees apart (``wheel:4@8`` at ``r3``): where the lane towards ``r0``
     starts, the end of the lane arriving from ``c`` is within a side sensor's reach. A
     robot leaving towards ``r0`` whose left sensor finds that corner keeps seeking
-    (issue 27: it had followed it and was lost); its centre sensor on its own lane ends
+    (a robot that followed it would be lost); its centre sensor on its own lane ends
     the seek. Positions in the true frame, the robot's odometry set to it."""
     spec = load_arena("wheel:4@8")
     sim = Simulation(arena_world_spec(spec, [Pose2D(*spec.vertices["r3"], 0.0)]))
@@ -188,8 +188,8 @@ def test_leaving_a_vertex_does_not_take_a_neighbours_spoke_for_its_lane(across_m
     """Edges 45 degrees apart (``wheel:4@8`` at ``r2``): leaving towards ``c``, the right
     sensor ends the sidestep a few millimetres beside the outer end of the spoke towards
     ``r1``, 45 degrees to the left. A sensor on that spoke (anywhere across its 30 mm
-    strip) is not on the lane sought (issue 27: with slip 0.05 a robot took it for its
-    lane, followed it off the vertex and was lost); a sensor on the lane's start is."""
+    strip) is not on the lane sought (with slip 0.05 a robot that took it for its lane
+    would follow it off the vertex and be lost); a sensor on the lane's start is."""
     spec = load_arena("wheel:4@8")
     sim = Simulation(arena_world_spec(spec, [Pose2D(*spec.vertices["r2"], 0.0)]))
     cal, conv = calibration(sim.geometry), conventions(sim.geometry)

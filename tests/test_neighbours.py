@@ -55,7 +55,7 @@ def test_every_pair_and_the_tree_propose_the_same_pairs(monkeypatch, seed):
 
 def separate_bearings(sim, fov_rad: float, range_m: float) -> tuple[np.ndarray, ...]:
     """The bearing sensor with a k-d tree and line of sight of its own, every pair's
-    bearing wrapped in full (the sensor before the shared search)."""
+    bearing wrapped in full (a reference without the shared search)."""
     poses = sim.poses()
     pairs = cKDTree(poses[:, :2]).query_pairs(range_m, output_type="ndarray")
     k = np.concatenate([pairs[:, 0], pairs[:, 1]])

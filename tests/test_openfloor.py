@@ -97,8 +97,8 @@ class _Drive(Controller):
 
 @pytest.mark.parametrize("world", [PointWorld, EmbodiedFloor])
 def test_a_control_period_is_integrated_exactly(world):
-    """Issue 28: with patrol's 0.15 s tick both worlds drove 0.16 s per tick (ten ticks at
-    0.1 m/s ended at x = 0.160 m)."""
+    """With patrol's 0.15 s tick both worlds drive exactly 0.15 s per tick (ten ticks at
+    0.1 m/s end at 1.5 s and, but for the motors' ramp, at x = 0.150 m)."""
     w = world([(0.0, 0.0)], control_dt_s=0.15)
     Loop(w, {0: _Drive()}).run(max_ticks=10)
     assert w.time_s == pytest.approx(1.5)

@@ -1,4 +1,4 @@
-"""Issue 26: outputs a user can trust (special files, symlinks, interruptions, one path for
+"""Outputs a user can trust (special files, symlinks, interruptions, one path for
 two outputs, file modes) and inputs refused in one line before any work."""
 
 from __future__ import annotations

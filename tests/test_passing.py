@@ -1,4 +1,4 @@
-"""Passing a robot that stopped on its lane (issue 30): the robot sees it with its own
+"""Passing a robot that stopped on its lane (ours): the robot sees it with its own
 senses, the stations hold the opposite lane, and it passes there
 (algorithms/exploration/explorer.py, algorithms/navigation/navigator.py,
 mjswarm/experiments/stations.py)."""
@@ -102,14 +102,13 @@ def test_a_pass_next_to_a_vertex_steps_across_with_its_sensor_on_the_incoming_sp
 @pytest.mark.parametrize("dies_at_s", [25.6, 90, 91])
 def test_a_robot_passes_a_dead_one_and_the_team_completes_the_true_map(dies_at_s):
     """``arena2``, 4 robots: R1 fails at 90 s at the start of its corridor from v3 to v4;
-    the robot sent along that edge next passes it (before passing, the run stalled). At
+    the robot sent along that edge next passes it (without passing, the run stalls). At
     91 s it stands 0.33 m along that 0.6 m edge, and the opposite lane ends 0.11 m past
     it, before the passer is clear of it: the passer drives on and steps square onto the
-    centre line (``Navigator._lane_ended``); the diagonal shift had touched the body (23
-    contact events). At 25.6 s it stands on the first edge, 0.255 m from ``v2``'s centre
+    centre line (``Navigator._lane_ended``); a diagonal shift would touch the body. At 25.6 s it stands on the first edge, 0.255 m from ``v2``'s centre
     (just beyond the radius that closes the vertex): stepping across a diameter and a
-    margin past it left the passer's centre sensor beyond the incoming spoke, and it
-    stopped 15 cm off ``v2`` (``Navigator._square_clearance_m``)."""
+    margin past it would leave the passer's centre sensor beyond the incoming spoke, and
+    it would stop 15 cm off ``v2`` (``Navigator._square_clearance_m``)."""
     spec = load_arena("arena2")
     config = EmbodiedConfig(faults=[parse_fault(f"robot:1@{dies_at_s}")])
     run = EmbodiedExploration(spec, make_minds("incidence-dfs", 4, 0), config, 0)

@@ -1,4 +1,4 @@
-"""Issue 27: the line filter and the scan hold under sensor noise (pure, no physics)."""
+"""The line filter and the scan hold under sensor noise (pure, no physics)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ STRIP_M = 0.002  # strip height
 
 
 def single_threshold(d: float) -> bool:
-    """The detection before issue 27: one reading against one threshold."""
+    """The plain detection: one reading against one threshold."""
     return FLOOR_M - d > LINE_THRESHOLD_M
 
 
@@ -76,9 +76,9 @@ def strip_crossings(sigma: float, seed: int, strips: int = 80) -> int:
 def test_a_noise_at_a_window_limit_sees_each_strip_once():
     """Noises at a window's limit (0.5 and 0.54 mm about 7 readings' 0.53 mm, 0.33 mm
     about 5 readings' 0.32 mm) move the estimate across the limit again and again; a
-    window that followed it tick by tick changed its mean and lag mid-strip and saw 3
-    strips twice in these 1440 (a robot took its new lane for ended). The window now
-    shrinks only with ``WINDOW_HYSTERESIS`` to spare: each strip once."""
+    window that followed it tick by tick would change its mean and lag mid-strip and see
+    some strips twice (a robot would take its new lane for ended). The window shrinks
+    only with ``WINDOW_HYSTERESIS`` to spare: each strip once."""
     assert all(strip_crossings(sigma, seed) == 80 for sigma in (0.0005, 0.00054, 0.00033)
                for seed in range(6))
 
@@ -138,10 +138,9 @@ def test_scan_finds_each_spoke_once_at_its_centre_under_noise(seed):
 
 @pytest.mark.parametrize("over_read", [0.0, 0.07, 0.09])
 def test_an_uncalibrated_scan_that_over_reads_its_turn_still_closes_it(over_read):
-    """Issue 27's "all noises" run: a first scan read 384 degrees for one turn (scrub and
-    slip 0.05), past the symmetric 22.5 degrees then allowed, scanned 2.5 turns
-    uncalibrated and set off 45 degrees wrong. Odometry never under-reads a turn: the
-    window is skewed to over-reading, and spokes 45 degrees apart stay apart."""
+    """The noise grid's "all noises" run: a first scan can read 384 degrees for one turn
+    (scrub and slip 0.05), past a symmetric 22.5 degrees. Odometry never under-reads a
+    turn: the window is skewed to over-reading, and spokes 45 degrees apart stay apart."""
     spokes = [100.0, 145.0, 260.0]
     scan = scan_spokes(spokes, 0.0005, 0, math.asin(0.3), over_read)
     assert scan.full_turn == pytest.approx(2 * math.pi * (1 + over_read), abs=math.radians(2))
@@ -152,13 +151,12 @@ SPOKE_WIDTH = 2.0 * math.asin(0.3)  # a 30 mm strip at the sensor's 50 mm: 35 de
 
 
 def test_a_scan_off_the_centre_tells_spokes_45_degrees_apart_under_noise():
-    """Issue 27, ``wheel:4@8``, 4 robots, 0.05 m/s, line noise 0.5 mm, dynamic: R1 stood
-    6 mm across its incoming spoke at ``r3`` (spokes at 53, 98 and 143 degrees), the gap
-    between the spokes at 98 and 143 degrees shrank to 4 readings under its sensor, the
-    line filter's 7 could not open it, and the scan reported one spoke at 124 degrees:
-    the robot set off between two edges and was lost, and the next robot at ``r3``
-    stopped on the beacon it wrote. Here 9.5 mm across: without ``spoke_width`` (one
-    spoke per run, as before) the scan merges them; with it, three spokes, within 2.5
+    """``wheel:4@8``, 4 robots, 0.05 m/s, line noise 0.5 mm, dynamic: a robot standing
+    6 mm across its incoming spoke at ``r3`` (spokes at 53, 98 and 143 degrees) sees the
+    gap between the spokes at 98 and 143 degrees shrink to 4 readings under its sensor,
+    which the line filter's 7 cannot open; one spoke per run would report one spoke at
+    124 degrees, between two edges. Here 9.5 mm across: without ``spoke_width`` (one
+    spoke per run) the scan merges them; with it, three spokes, within 2.5
     degrees once corrected for standing off the centre (six noise seeds)."""
     from algorithms.navigation.navigator import off_centre_correction
 
@@ -181,8 +179,8 @@ def test_a_scan_off_the_centre_tells_spokes_45_degrees_apart_under_noise():
 def test_bearing_noise_neither_triggers_nor_suppresses_the_rule():
     """2 degrees of bearing noise: a robot whose bearing turns at 0.1 rad/s (passing) is
     never taken for a collision course; one at a constant bearing (a collision course)
-    is, within the longest window. The 10-sample window alone (the rule before issue
-    27) triggers on the passing robot."""
+    is, within the longest window. The 10-sample window alone (the noise-free
+    rule) triggers on the passing robot."""
     rng = np.random.default_rng(3)
     noise = math.radians(2.0)
     passing = [{1: 0.4 + 0.1 * 0.02 * i + rng.normal(0, noise)} for i in range(300)]
@@ -229,11 +227,11 @@ def test_noise_free_wall_readings_are_judged_one_by_one():
 
 
 def test_the_speed_rule_sees_bearings_along_the_lane_not_the_swung_nose():
-    """``arena2``, 4 robots, 0.2 m/s, 0.5 mm line noise, kinematic (issue 27's sample): a
-    robot whose nose had swung 4.4 degrees on its lane saw a robot standing on the vertex
-    beyond the next one 1.3 degrees off its nose, inside the rule's 2.6 degree "same lane"
-    cone: it stopped for good, and that robot waited for the vertex it held. In the lane's
-    frame that robot is 5.7 degrees off (slow, not stop); the lane's direction does not
+    """``arena2``, 4 robots, 0.2 m/s, 0.5 mm line noise, kinematic (the noise grid's
+    sample): a robot whose nose has swung 4.4 degrees on its lane sees a robot standing on
+    the vertex beyond the next one 1.3 degrees off its nose, inside the rule's 2.6 degree
+    "same lane" cone; stopping for it would wait for ever, since that robot waits for the
+    vertex the first holds. In the lane's frame that robot is 5.7 degrees off (slow, not stop); the lane's direction does not
     follow the nose while the robot stands."""
     from algorithms.navigation.navigator import ArenaConventions, Navigator, NavigatorState
 

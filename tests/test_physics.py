@@ -109,9 +109,9 @@ def test_ir_reads_nothing_beyond_range(gap_m):
 
 @pytest.mark.parametrize("speed", [0.1, 0.2])
 def test_a_sudden_stop_does_not_pitch_the_line_sensors_onto_a_strip(one_robot, speed):
-    """Issue 13: the motor ramp keeps the line sensors within 0.5 mm of their bare-floor
-    reading when a robot is told to stop dead from cruising (an instant stop dipped them by
-    the 2 mm of a strip, and robots then followed phantom lanes)."""
+    """The motor ramp keeps the line sensors within 0.5 mm of their bare-floor reading
+    when a robot is told to stop dead from cruising (an instant stop would dip them by the
+    2 mm of a strip, and robots would follow phantom lanes)."""
     for _ in range(100):
         one_robot.set_velocity(speed, 0.0)
         one_robot.step()

@@ -1,4 +1,4 @@
-"""``mjswarm plot`` pictures read on their own (issue 26, item 11): read back as SVG with
+"""``mjswarm plot`` pictures read on their own: read back as SVG with
 text kept as text, they name the arena's parts, every robot (one that never left the
 depot too), the end dots, how the run ended, a partial recording, and the graph world's
 visit order."""

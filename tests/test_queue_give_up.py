@@ -1,4 +1,4 @@
-"""Giving up a place in a queue (issue 29, item 5; :mod:`algorithms.exploration.entry`,
+"""Giving up a place in a queue (ours; :mod:`algorithms.exploration.entry`,
 step 8): a robot whose request waits too long plans again round that edge
 (``Strategy.give_up``), and the exploration still ends with the true map.
 

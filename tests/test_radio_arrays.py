@@ -1,4 +1,4 @@
-"""The radio's delivery by arrays equals delivery copy by copy (the radio before issue 29):
+"""The radio's delivery by arrays equals delivery copy by copy (a reference radio):
 the same messages in every inbox in the same order, the same counters and the same drops
 for the same seed, on random teams, links, sends, removals, blackouts and drops. And
 payloads are immutable values."""

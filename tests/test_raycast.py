@@ -1,7 +1,7 @@
 """Grid ray casting equals MuJoCo's: ``mj_ray`` per ray, and plain rangefinders per robot.
 
 The O(N) sensing (:mod:`mjswarm.core.raycast`, ``Simulation(sensing="grid")``) must give the
-readings MuJoCo's own rangefinders give on the same states, within 1e-9 (issue 8). Random
+readings MuJoCo's own rangefinders give on the same states, within 1e-9. Random
 states put robots anywhere on an arena with walls and strips, against walls, against and
 inside each other, and some tipped over or upside down (their line sensors miss the floor
 and take the ``mj_ray`` fallback).

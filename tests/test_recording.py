@@ -1,4 +1,4 @@
-"""Recordings (issue 5 part 4): files rerun accepts, the documented entity tree, and the
+"""Recordings: files rerun accepts, the documented entity tree, and the
 per-tick data read back equal to what was logged, over seeded random runs."""
 
 from __future__ import annotations
@@ -167,7 +167,7 @@ def test_blueprint_has_the_review_views(fig9_recording):
 
 
 def test_blueprint_without_radio_has_no_radio_views(tmp_path):
-    """Issue 18: a run without radios does not open on empty radio views."""
+    """A run without radios does not open on empty radio views."""
     path = tmp_path / "quiet.rrd"
     Recorder(path, load_arena("fig9"), 2).close()
     names = _view_names(path)

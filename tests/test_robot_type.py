@@ -150,7 +150,7 @@ class Counting(Recorder):
 
 
 def test_the_loop_senses_all_then_controls_all_then_acts_all_then_steps():
-    """ARGoS's phases (issue 28): no robot acts before every robot has sensed."""
+    """ARGoS's phases: no robot acts before every robot has sensed."""
     world = Logged([(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)])
     Loop(world, {i: Recorder() for i in range(3)}).run(max_ticks=2)
     tick = ["observe 0", "observe 1", "observe 2", "act 0", "act 1", "act 2", "step"]

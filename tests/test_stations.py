@@ -51,7 +51,7 @@ def test_a_held_vertex_waits_and_requests_are_served_in_order(lattice):
 
 
 def test_a_swap_along_one_edge_is_granted_to_both(lattice):
-    """Issue 13's deadlock, reduced: robots on both ends of an edge, each wanting the
+    """A deadlock, reduced: robots on both ends of an edge, each wanting the
     other's vertex, would wait for ever; the stations let them pass on their lanes."""
     lattice.occupy(0, "v0_0")
     lattice.occupy(1, "v0_1")
@@ -118,8 +118,8 @@ def test_no_circular_wait_survives_a_grant(seed):
 def test_a_swap_grants_both_robots_and_tells_each_its_vertex_is_not_yet_clear():
     """Two robots on the two ends of an edge, each asking for the other's vertex: the
     cycle is granted whole, and each is told that its vertex is still being left (a
-    grant told 'clear' before the other grant took effect drove robots into each other
-    in the stress grid); a robot's 'left' clears the other's way."""
+    grant told 'clear' before the other grant took effect would drive robots into each
+    other); a robot's 'left' clears the other's way."""
     run = EmbodiedExploration(load_arena("fig9"), make_minds("incidence-dfs", 2),
                               EmbodiedConfig(), 0)
     u, w = load_arena("fig9").edges[0]

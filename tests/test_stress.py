@@ -1,4 +1,4 @@
-"""Issue 13's robustness stress grid and issue 27's noise grid (mjswarm.experiments.stress):
+"""The robustness stress grid and the noise grid (mjswarm.experiments.stress):
 a fast representative of each failure class and of each noise by default, the whole grids
 with ``-m slow``."""
 
@@ -57,11 +57,11 @@ def test_table_counts_what_it_ran():
     assert "| `issue13-fan` | 1 | 1 | 1 | 0 | 0 |" in text
 
 
-#: Issue 30's dense teams at the top speed, one robot for every 5 edges, that stalled:
-#: a robot on its lane stopped for good (speed rule, beta = 0) for one standing on the
-#: centre of the vertex beyond the next, and that one waited for the vertex the first
-#: held. The rule now takes bearings in the lane's frame (issue 27's lane_bearings), so a
-#: nose turned a few degrees off the lane no longer brings such a robot into the cone.
+#: Dense teams at the top speed, one robot for every 5 edges, where a robot on its lane
+#: could stop for good (speed rule, beta = 0) for one standing on the centre of the vertex
+#: beyond the next, which waits for the vertex the first holds. The rule takes bearings
+#: in the lane's frame (the navigator's lane_bearings), so a nose turned a few degrees off
+#: the lane does not bring such a robot into the cone.
 DENSE = [StressRun("lattice:6x6", 12, 0.2, 1), StressRun("lattice:8x8", 16, 0.2, 2)]
 
 
@@ -109,7 +109,7 @@ def test_the_dead_grid_spreads_faults_over_robots_times_speeds_and_tiers():
 
 @pytest.mark.slow
 def test_the_dead_robot_grid_passes():
-    """Issue 30's dead-robot grid: every run completes the true map or the reachable part
+    """The dead-robot grid: every run completes the true map or the reachable part
     (a closed root included), no contact, nobody stopped but the failed robot."""
     rows = run_grid(dead_grid(), workers=2)
     failures = [(r, res.ended_because, res.collisions, res.stopped_robots)
@@ -131,23 +131,23 @@ def test_the_whole_grid_passes(make):
     ("arena2", 4, 0.2), ("arena2", 4, 0.15), ("fig9", 2, 0.15), ("lattice:10x10", 10, 0.05),
 ])
 def test_issue_13_reports_pass_with_default_seeds(arena, robots, speed):
-    """The runs issue 13 reported, as the CLI runs them (no seed)."""
+    """Runs of the main arenas and a big lattice, as the CLI runs them (no seed)."""
     result = StressRun(arena, robots, speed, None).run()
     assert passed(result), (result.ended_because, result.collisions, result.stopped_robots)
 
 
 @pytest.mark.slow
 def test_a_lone_robot_keeps_its_heading_over_384_legs():
-    """Issue 13: odometry heading error stays a few degrees over a 300+ leg run (it was
-    -36.5 degrees after the 384 legs of lattice:12x12)."""
+    """Odometry heading error stays within 5 degrees over a 300+ leg run (the 384 legs of
+    lattice:12x12)."""
     result = StressRun("lattice:12x12", 1, 0.2, None).run(max_sim_time_s=20000.0)
     assert passed(result) and result.total_traversals >= 300
     assert result.heading_error_deg < 5.0
 
 
 @pytest.mark.parametrize("run", [
-    # 0.5 mm of line noise: scans found phantom spokes (the dynamic tier's floor reads
-    # 0.46 mm below the calibration, 0.54 mm from the old fixed threshold)
+    # 0.5 mm of line noise: a fixed threshold would find phantom spokes (the dynamic
+    # tier's floor reads 0.46 mm below the calibration, 0.54 mm from that threshold)
     StressRun("fan:3:45@17", 1, 0.2, 0, Noise(line_m=0.0005), "dynamic"),
     StressRun("fig9", 2, 0.15, 0, Noise(ir_m=0.002), "kinematic"),
     StressRun("fig9", 2, 0.15, 0, Noise(bearing_deg=2.0), "kinematic"),
@@ -171,11 +171,11 @@ def test_noise_representatives(run):
 
 
 def test_leaving_a_45_degree_junction_under_every_noise_keeps_off_a_neighbours_spoke():
-    """Issue 27, the noise grid's ``wheel:4@8``, 4 robots, 0.1 m/s, every noise with slip
-    0.05, kinematic, seed 1: leaving ``r2``, R1's right sensor found the outer end of the
-    spoke 45 degrees to the left, 9 cm short of its lane's start, and R1 followed it off
-    the vertex (lost at 89.5 s, three edges unreachable). The heading is the slip's
-    (``README``: slip 0.05 is not met), not asserted here."""
+    """The noise grid's ``wheel:4@8``, 4 robots, 0.1 m/s, every noise with slip 0.05,
+    kinematic, seed 1: leaving ``r2``, R1's right sensor finds the outer end of the spoke
+    45 degrees to the left, 9 cm short of its lane's start, and must not follow it off the
+    vertex. The heading is the slip's (slip 0.05 does not meet the heading criterion,
+    ``docs/exploration.md``), not asserted here."""
     result = StressRun("wheel:4@8", 4, 0.1, 1, NOISES[-1], "kinematic").run(max_sim_time_s=1200.0)
     assert passed(result), (result.ended_because, result.collisions, result.stopped_robots)
 

@@ -59,7 +59,7 @@ def test_ray_backend_on_a_local_two_cpu_instance(tmp_path):
 
 
 def test_embodied_cell_runs_with_a_constraint():
-    """An embodied cell of issue 17's grid: the MuJoCo robots on their tether."""
+    """An embodied cell of the connected-exploration grid: the MuJoCo robots on their tether."""
     record = run_cell(Cell("embodied", "arena1", 2, "incidence-dfs", 0, 3.0, "connected"))
     assert record["completed"] and record["collisions"] == 0 and "sim_time_s" in record
     assert record["connectivity"] == "connected" and record["cut_ticks"] == 0
@@ -95,7 +95,7 @@ def test_grid_rejects_nothing_to_do():
 
 
 def test_a_sweep_over_radio_ranges_and_constraints(tmp_path):
-    """Issue 17's grid: ranges x constraints in the graph world, each cell its own run."""
+    """The connected-exploration grid: ranges x constraints in the graph world, each cell its own run."""
     out = tmp_path / "radio.csv"
     cells = grid("graph", ["arena2"], [4], ["incidence-dfs"], [0], [1.0, 50.0],
                  ["none", "connected", "biconnected"])

@@ -1,4 +1,4 @@
-"""Videos, summary pictures and camera frames in recordings (issue 15): they render on a
+"""Videos, summary pictures and camera frames in recordings: they render on a
 machine without a display (MUJOCO_GL=egl), decode, and show what the robots did."""
 
 from __future__ import annotations

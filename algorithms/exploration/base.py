@@ -18,7 +18,7 @@ calls :meth:`Strategy.on_vertex` with
 
 It answers with a :class:`Decision`: leave along the edge at ``angle``, ``DONE``
 (completion declared), ``IDLE`` (nothing to do now; the world calls again one time unit
-later with ``arrived_by=None``) or, only where vertices close (issue 30), ``CUT_OFF``.
+later with ``arrived_by=None``) or, only where vertices close (a body that cannot be passed), ``CUT_OFF``.
 
 Robots that arrive at one vertex at the same time are handled one after another, each
 seeing the beacon as the previous one left it, in *descending* robot index. Seed 003's
@@ -59,7 +59,7 @@ class Decision:
 
 DONE = Decision("done")
 IDLE = Decision("idle")
-#: Cut off from the root by closed vertices (issue 30), with every end of its reach
+#: Cut off from the root by closed vertices, with every end of its reach
 #: completed or blocked: the robot finished the part of the graph it can still reach and
 #: stops for good (it declares nothing: see ``incidence_matrix``'s rule).
 CUT_OFF = Decision("cut off")
@@ -77,7 +77,7 @@ class Beacon:
     robot R1 names its beacons a1, a2, ...; see :mod:`algorithms.exploration.beacon_ids`).
     ``data`` is whatever the strategy keeps there (for seed 003, the incidence matrix).
     ``frame`` is what an embodied robot keeps there of the frame its stored angles are in
-    (issue 27's frame fusion): ``(offset, variance)``, how far (rad) the robots
+    (the frame fusion of :func:`~algorithms.navigation.navigator.fuse_frames`): ``(offset, variance)``, how far (rad) the robots
     believe those angles lie from the common frame and how sure (rad^2); ``None`` until
     the robot that dropped the beacon writes it (:mod:`~algorithms.exploration.explorer`).
     """
@@ -193,7 +193,7 @@ class Strategy(ABC):
     def block(self, angle: float) -> None:
         """The edge at incidence ``angle`` (rad, the beacons' frame) from the vertex of
         the latest call leads to a closed vertex (its station answered
-        :class:`~algorithms.exploration.entry.EntryBlocked`; issue 30): the robot did not
+        :class:`~algorithms.exploration.entry.EntryBlocked`): the robot did not
         leave. The world then calls :meth:`on_vertex` again at that vertex with
         ``arrived_by`` None, and that call writes the mark into the beacon and decides
         anew. Only ``incidence-dfs`` routes round closed vertices

@@ -44,7 +44,7 @@ and every message is counted with the radio's. The protocol, from the robot's si
    asks for the way its mission takes. A grant names the request's angle, so that one
    overtaken by a withdrawal is known as such. A withdrawn swap leaves the other robot
    waiting, as before, until this one has left the vertex area it was given.
-6. Passing (ours, issue 30). A robot whose lane is blocked by a body that does not move
+6. Passing (ours: not in the paper). A robot whose lane is blocked by a body that does not move
    and is silent (:meth:`~algorithms.exploration.explorer.Explorer._stopped_body`) asks
    to pass it on the opposite lane: :class:`PassRequest`. The opposite lane leads from
    the vertex ahead ``w`` back to the vertex it left ``u``; from the request on, the
@@ -53,7 +53,7 @@ and every message is counted with the radio's. The protocol, from the robot's si
    from ``w`` and not yet on ``u``'s centre). The robot passes and, off the opposite
    lane, sends :class:`PassDone`: the station opens the lane again. The pass is held
    like a vertex area: one robot per lane, so nothing comes towards it.
-7. Closed vertices (issue 30: a body that cannot be passed). A vertex whose area holds
+7. Closed vertices (ours: a body that cannot be passed). A vertex whose area holds
    a robot that stopped for good is *closed*: its station answers every request for it
    with :class:`EntryBlocked` instead of a grant, at once for requests waiting in its
    queue and for new ones when they come, naming the request's angle and never the
@@ -66,7 +66,7 @@ and every message is counted with the radio's. The protocol, from the robot's si
    the edge blocked
    (:meth:`~algorithms.exploration.base.Strategy.block`) and decides anew.
 
-8. Giving up a place in a queue (ours, issue 29). Robots heading for one frontier queue
+8. Giving up a place in a queue (ours: not in the paper). Robots heading for one frontier queue
    vertex by vertex for grants (each waits on a centre for the vertex whose holder
    waits for the next), and a queue that reaches back to the root stops the launches. A
    robot on a centre whose request has not been granted for ``GIVE_UP_S`` sends
@@ -91,11 +91,11 @@ STATION = "station"
 #: up its place (step 8): twice the longest wait measured in a run without a long queue.
 #: Waits from a centre to its grant (``python benchmarks/grant_waits.py EXPLORE-ARGS``):
 #: the main job (arena2, 4 robots) 0-26 s; a dense team (lattice:6x6, 8 robots, 0.15 m/s,
-#: seed 1) median 0, 99th percentile 44 s, longest 58 s; a queue (lattice:12x12, 120
-#: robots, 0.15 m/s, kinematic, on the code before this step, f1baf58) 53 waits over
-#: 60 s, 29 over 120 s, the longest 710 s. Queues form in small
-#: teams too, behind a hub: 23 of the stress grid's 100 runs give up 46 places in all
-#: (wheel:8 in 8 of its 12), and every run still passes (README, issue 29).
+#: seed 1) median 0, 99th percentile 44 s, longest 58 s; in a long queue (lattice:12x12,
+#: 120 robots, 0.15 m/s, kinematic) robots that never gave up would wait for minutes.
+#: Queues form in small teams too, behind a hub: some of the stress grid's runs give up
+#: places (``python -m mjswarm.experiments.stress``; wheel:8 most), and every run passes
+#: (``docs/exploration.md``).
 GIVE_UP_S = 120.0
 
 

@@ -11,7 +11,7 @@ It composes, fed only by its own observation:
 * vertex entry (:mod:`algorithms.exploration.entry`) with the stations;
 * optionally a :class:`~algorithms.connectivity.ConnectivityTable` (seed 004) kept over
   its radio: its belief whether a single robot's loss would cut it off the reference;
-* optionally a :class:`~algorithms.exploration.tether.Tether` (issue 17's connected
+* optionally a :class:`~algorithms.exploration.tether.Tether` (connected
   exploration), in the graph world's :class:`~algorithms.exploration.relay.ConnectedExplorer`
   (rules 1-6, the same object around the same strategy): it reads its radio neighbours'
   ranges and bearings (``Observation.detections``), and it does not drive a control
@@ -38,14 +38,14 @@ Choices beyond the paper (the loop functions in :mod:`mjswarm.experiments.explor
 
 * **The speed rule applies on edges** (following a lane, seed 003 Sec. 4 "traversing an
   edge"); in the vertex area robots move at S and are kept apart by vertex entry. A robot
-  slowed by the rule while leaving a vertex would keep that vertex's area occupied
-  (issue 13), and at the vertex centre the rule's "beta = 0: stop" would stop a robot
+  slowed by the rule while leaving a vertex would keep that vertex's area occupied,
+  and at the vertex centre the rule's "beta = 0: stop" would stop a robot
   facing one that waits on the next vertex for this one: a deadlock.
 * **Heading re-anchoring**: at a vertex whose beacon already stores angles
   (``Strategy.stored_angles``), the robot rotates its heading frame onto them
   (:func:`~algorithms.navigation.navigator.frame_offset`), so odometry drift does not
   accumulate over revisits and every robot keeps the beacons' frame. Frame fusion
-  (issue 27): the robot that drops a beacon writes its frame's variance there
+  (ours): the robot that drops a beacon writes its frame's variance there
   (``Beacon.frame``: its heading variance plus a scan's), and a robot that has found slip
   turns only part of the way onto a stored frame, by the two variances, and moves the
   beacon's believed offset part of the way towards its own frame
@@ -116,7 +116,7 @@ from algorithms.robot import Command, Controller, Message, Observation
 #: A relay stops this far short of where its requester stood on their lane (m): two body
 #: diameters, so that a requester backing out of a wall's shadow does not reach it.
 RELAY_SPACING_M = 0.3
-#: The creep (ours; issue 30's dense teams): a robot on its lane that the speed rule has
+#: The creep (ours, for dense teams): a robot on its lane that the speed rule has
 #: held still this long (s) creeps on at ``CREEP_M_S`` (m/s) while its front IR sees
 #: nothing nearer than ``CREEP_GUARD_M`` (m, from the chassis rim; the IR's cutoff is
 #: 0.10 m, and at 5 cm/s the motors' 0.05 s ramp stops it within 3 mm).
@@ -124,16 +124,16 @@ CREEP_AFTER_S = 5.0
 CREEP_M_S = 0.05
 CREEP_GUARD_M = 0.06
 #: A robot that waits at its wall's end for the vertex ahead to clear (vertex entry) backs
-#: this far (m) along its lane, at ``CREEP_M_S``, from where it stopped (ours; issue 30's
+#: this far (m) along its lane, at ``CREEP_M_S``, from where it stopped (ours, for
 #: dense teams). The arena places the wall's end so that a robot waiting there stands
 #: 0.26 m from the vertex centre, clear of a robot leaving along a neighbouring edge
 #: (:data:`mjswarm.arena.geometry.VERTEX_CLEAR_RADIUS_M`); but the wall's end is seen
 #: after the IR's debounce and the stop takes the motors' ramp, and at 0.2 m/s robots
-#: stopped 0.236-0.239 m from the centre, where one touched a robot leaving 90 degrees
+#: stop 0.236-0.239 m from the centre, where one can touch a robot leaving 90 degrees
 #: away (``lattice:6x6``, 12 robots, 0.2 m/s, seed 2). The lane leads to the vertex the
 #: robot holds, so nobody is behind it on it.
 WAIT_BACKOFF_M = 0.04
-#: Passing a stopped body (ours, issue 30; :meth:`Explorer._stopped_body`): a body its
+#: Passing a stopped body (ours; :meth:`Explorer._stopped_body`): a body its
 #: front IR has seen within range, steady to ``PASS_STEADY_M`` (m: five times the 2 mm
 #: of the noisiest IR the noise grid runs), for ``PASS_AFTER_S`` (s) while the robot stood
 #: on its lane: twice the creep's wait, so that a phantom stop has been crept out of
@@ -204,7 +204,7 @@ class Explorer(Controller):
         #: why it stopped for good, or None
         self.halted: str | None = None
         #: whether its strategy finished: declared the exploration complete, or finished
-        #: the part it can reach, cut off from the root (``CUT_OFF``, issue 30)
+        #: the part it can reach, cut off from the root (``CUT_OFF``)
         self.finished = False
         #: its speed in the last tick (m/s): the rule's on a lane, else S
         self.speed_m_s = speed_m_s
@@ -325,8 +325,7 @@ class Explorer(Controller):
         """A parent's link is gone (a wall came between them: the leash knows ranges, not
         walls): drive its last moves backwards until the link is back, then wait for a new
         parent as if the leash had stopped it (on a vertex centre, at once: a robot backed
-        out of the centre it scans on would scan off it, find no beacon and stop, as one
-        did on ``arena2`` before session 9)."""
+        out of the centre it scans on would scan off it, find no beacon and stop)."""
         self._occluded.add(self._way)
         self._cut |= {q for q in self.tether.parents if q not in around}
         if not self._trail:

@@ -48,7 +48,7 @@ Choices where the paper is silent or ambiguous (each checked by tests):
   block fixed and moves the selected column to the front of the out block; the sparse
   matrix records it as one more selection of that out edge (``IncidenceMatrix.out``).
 * Completion is tested at every vertex visit, including vertices passed while travelling.
-* **Closed vertices** (ours, issue 30: a robot stopped for good in a vertex area that no
+* **Closed vertices** (ours: a robot stopped for good in a vertex area that no
   robot can pass). The station of a closed vertex answers a request for it with
   ``EntryBlocked``; the robot has not left, and :meth:`IncidenceDFS.block` marks the end it
   asked for blocked (:mod:`~algorithms.exploration.incidence_matrix`: a blocked end is
@@ -207,7 +207,7 @@ class IncidenceDFS(FrontierExplorer):
     def give_up(self, angle: float) -> None:
         """The robot waited too long for the vertex across the edge at ``angle`` (rad, the
         beacons' frame) from the vertex of the latest call, and did not leave
-        (:mod:`~algorithms.exploration.entry`, step 8; ours, issue 29): it drops its queue
+        (:mod:`~algorithms.exploration.entry`, step 8; ours): it drops its queue
         and, at the next call here, plans without leaving by that edge (nor by any other
         it gave up here). Nothing is written into the matrix: the edge keeps its status
         (out, if it selected it: the marks of an abandoned selection stay, as after a

@@ -30,7 +30,7 @@ its bits say. ``rows``, ``completed`` and ``out`` are built from the bits when a
 in numbering order (the order in which the team first wrote each entry). Matrices of
 different numberings (built directly, e.g. by a test) are merged after renumbering one.
 
-Blocked ends (ours, issue 30: a body that cannot be passed). An end is *blocked* when
+Blocked ends (ours: a body that cannot be passed). An end is *blocked* when
 the vertex at its far end is closed: a robot stopped for good in that vertex's area,
 and the station there answers every request for it with
 :class:`~algorithms.exploration.entry.EntryBlocked`. The robot that asked marks the end
@@ -58,7 +58,7 @@ end of it leads anywhere else), which no robot can enter or leave any more; it h
 finished that part and stops (``CUT_OFF``). Only the team can tell that nothing is left
 (no robot knows whether others, cut off elsewhere, still work): the embodied
 experiment's rule for that is ``team_cut_off`` in ``mjswarm.experiments.metrics``. The bit set is 0 in every
-run without closed vertices, and every query then takes the old path.
+run without closed vertices, and every query then takes the path without blocked ends.
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ Rules inferred where the paper's text was not available to us:
   unexplored edges): Brass et al.'s bookkeeping devices record every arrival before any
   robot leaves. Decided in arrival order instead, a robot would not yet know that
   another had just come in along a cycle edge and would traverse that edge again
-  (issue 16: fig9 with 2 robots 14 instead of 12).
+  (fig9 with 2 robots: makespan 14, against 12).
 * The map (for metrics) is built with the incidence matrix like every strategy
   (:mod:`~algorithms.exploration.mapping`); it plays no part in the decisions.
 

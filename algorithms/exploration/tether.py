@@ -1,4 +1,4 @@
-"""Exploration that stays connected: the tether every robot keeps to the base (issue 17).
+"""Exploration that stays connected: the tether every robot keeps to the base.
 
 Seed 003 explores without communication limits; seeds 001, 002 and 004 keep a team
 connected but do not explore. Here each robot explores with its seed-003 strategy while it

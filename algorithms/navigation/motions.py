@@ -159,7 +159,7 @@ class FollowLine:
       side sensor that turns on just then belongs to another strip: near a vertex centre
       the inner ends of the spokes of edges 45-90 degrees apart come within a side
       sensor's reach, and following that sensor would carry the robot out along a
-      neighbouring spoke (issue 13). Drifting sideways never looks like this (the side
+      neighbouring spoke. Drifting sideways never looks like this (the side
       sensor holding the strip was on before the centre left it);
     * *laterally lost*: no sensor has seen it over LINE_END_GAP_M; meanwhile the follower
       keeps its last correction (the strip is beyond the outer sensor).
@@ -266,7 +266,7 @@ class FollowSpoke:
     direction (the mean heading of those aligned ticks) and no longer steers by the side
     sensors: where edges are 45 degrees apart the inner ends of neighbouring spokes
     overlap, and a side sensor that reached one would steer the robot out along it
-    (issue 13; ``fan:3:45``). The spoke's centre line beyond its inner end crosses no
+    (``fan:3:45``). The spoke's centre line beyond its inner end crosses no
     other spoke. It ends where the centre sensor leaves the strip (:class:`CentreEnd`);
     ``direction`` is the held heading.
     """
@@ -328,9 +328,9 @@ class Scan:
     neighbouring spokes narrows where the robot stands off the vertex centre away from
     them (45 degrees apart, 6 mm off: 5 degrees, 4 readings at 1 rad/s and 50 Hz), and
     the line filter's window (7 readings at 0.5 mm of noise) cannot open a gap that
-    narrow (issue 27: ``wheel:4@8``, 4 robots, 0.05 m/s, line noise 0.5 mm, dynamic: R1
-    merged two spokes at ``r3`` into one between them, set off along neither and was
-    lost; its beacon then stopped the next robot there).
+    narrow (``wheel:4@8``, 4 robots, 0.05 m/s, line noise 0.5 mm, dynamic: taken as one,
+    two spokes at ``r3`` merge into one between them, along neither of which the robot
+    could set off).
 
     The scan keeps turning until the first spoke it measured comes round again, so the
     odometry angle between those two crossings, ``full_turn``, is exactly one true turn:
@@ -417,9 +417,10 @@ def _same_spoke(swept_between: float) -> bool:
     widens the effective track (1-2 per cent in the dynamic tier) and wheel slip makes
     the encoders read more than the wheels rolled (``|N(0, s)|`` per tick and wheel: 0.8 s
     on average, 4 per cent at ``--wheel-slip 0.05``); neither under-reads. Together they
-    reached 384 degrees for one turn (dynamic tier, slip 0.05 and line noise 0.5 mm; issue
-    27's "all noises" run, whose robot then scanned 2.5 turns uncalibrated and set off 45
-    degrees wrong), beyond the symmetric 22.5 degrees this test allowed. The window is
+    reach 384 degrees for one turn (dynamic tier, slip 0.05 and line noise 0.5 mm: the
+    noise grid's "all noises" run, ``python -m mjswarm.experiments.stress --noise``),
+    beyond a symmetric 22.5 degrees, where a robot would scan on uncalibrated and set
+    off along the wrong spoke. The window is
     skewed to over-reading, as wide as edges 45 degrees apart allow: the neighbouring
     spokes come round at 405 and 315 degrees of a true turn, and a window from
     ``360 (1 - u)`` to ``360 (1 + o)`` excludes them for every over-read in it while

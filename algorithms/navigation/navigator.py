@@ -17,7 +17,7 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
   runs at most at ``APPROACH_SPEED_M_S`` whatever the cruising speed, and once aligned
   with the spoke the robot holds its direction and watches only the centre sensor
   (:class:`~.motions.FollowSpoke`), so a neighbouring spoke's inner end, within a side
-  sensor's reach when edges are 45-90 degrees apart, cannot carry it away (issue 13);
+  sensor's reach when edges are 45-90 degrees apart, cannot carry it away;
 * **discovering edges**: rotate once in place (:class:`~.motions.Scan`); every spoke
   crossed gives an incidence angle, measured with encoder odometry. The spoke the robot
   came by lies opposite the lane's direction (measured on the lane, in the odometry
@@ -25,14 +25,14 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
   stands off-centre across it (:func:`off_centre_correction`). Scans turn
   counter-clockwise and clockwise in turn: each calibrates the odometry's track, but a
   residual scale error would add up over a long run's scans if they all turned one way
-  (issue 13: a lone robot's heading drifted 12 degrees over the 260 legs of
-  ``lattice:10x10`` at 0.2 m/s scanning one way, 7 alternating, both before re-anchoring);
+  (a lone robot's heading, without re-anchoring, over the 260 legs of ``lattice:10x10``
+  at 0.2 m/s);
 * **re-anchoring** (:meth:`Navigator.reanchor`): at a vertex whose beacon already stores
   angles, the caller rotates the robot's frame onto them (:func:`frame_offset`); once the
   robot has found slip (its odometry's distance scale), only part of the way, by the
-  weights of the two frames' variances (:func:`fuse_frames`, issue 27's
-  frame fusion);
-* **passing** (:meth:`Navigator.pass_body`, ours, issue 30): round a body that stands on
+  weights of the two frames' variances (:func:`fuse_frames`, frame
+  fusion);
+* **passing** (:meth:`Navigator.pass_body`, ours): round a body that stands on
   its lane, on the opposite lane: step square across to it, follow that lane
   until it is four body radii past where the body's front was, watching the corridor
   wall on its right (the right IR sees it there as the left IR does from its own lane),
@@ -311,7 +311,7 @@ class Navigator:
     def fuses_frames(self) -> bool:
         """Whether it fuses frames at a revisit (:meth:`reanchor`): once its odometry has
         found slip (a distance scale other than 1). Noise-free and line-noise runs never
-        find any and re-anchor fully, as before."""
+        find any and re-anchor fully."""
         return self.odometry.slip_sigma > 0.0
 
     def reanchor(self, stored: Sequence[float],
@@ -372,7 +372,7 @@ class Navigator:
         estimated in the odometry frame from the ticks aligned with it so far
         (:meth:`~.motions.FollowLine.direction`, all of the lane). The speed rule's
         ``beta = 0`` is "ahead on the same lane" (seed 003 eq. (27)); a line follower's
-        nose swings a few degrees about its lane (more when its line filter lags, issue 27),
+        nose swings a few degrees about its lane (more when its line filter lags),
         and a robot standing on the centre of the vertex beyond the next one, 5-13 degrees
         off the lane within the sensor's metre, came within the rule's 2.6 degree cone of
         the nose (``arena2``, 4 robots, 0.2 m/s, 0.5 mm line noise, kinematic: the robot
@@ -388,7 +388,7 @@ class Navigator:
     def _own_lane(self, angle: float):
         """Leaving along ``angle``: whether the strips the line sensors see now include
         the lane sought (the left lane of that edge) rather than a lane of a neighbouring
-        edge of this vertex (ours, issue 27). Lanes start where they no longer cross
+        edge of this vertex (ours). Lanes start where they no longer cross
         their neighbours' (:func:`mjswarm.arena.geometry.lane_setback`), at 27 cm for
         edges 45 degrees apart, and there the right lane of the edge 45 degrees to the
         left comes within 2.5 cm of the lane sought: a robot set off 2.4 degrees off its
@@ -516,10 +516,10 @@ class Navigator:
         ``sqrt((2 r + margin)^2 - offset^2)``, 0.144 m for the Spark V (a diameter and the
         margin straight along would be 0.17 m). The 2.6 cm matter: the station closes a
         vertex for a body within ``VERTEX_CLEAR_RADIUS_M`` (0.255 m) of its centre, and a
-        body just beyond it left a robot stepping across at 0.17 m past it with its centre
-        sensor beyond the incoming spoke's inner end; its seek found the spoke on the far
-        side of the centre and it stood 15 cm off the vertex (``arena2``, 4 robots, seed
-        0, ``robot:1@25.6``: the second robot stopped, the map was lost)."""
+        body just beyond it leaves a robot stepping across at 0.17 m past it with its centre
+        sensor beyond the incoming spoke's inner end; its seek finds the spoke on the far
+        side of the centre and it stands 15 cm off the vertex (``arena2``, 4 robots, seed
+        0, ``robot:1@25.6``: the second robot would stop, the map be lost)."""
         reach_m = 2.0 * self.cal.body_radius_m + PASS_MARGIN_M
         return math.sqrt(reach_m**2 - self.conv.lane_offset_m**2)
 
@@ -646,7 +646,7 @@ class Navigator:
 
 #: The variance (rad^2) of one vertex's frame as a scan measures it, without slip: each
 #: spoke's angle errs by about 0.9 degrees (the scan's sampling and standing off-centre;
-#: issue 27's measurements). A new beacon's frame holds its dropper's heading variance plus
+#: measured on the noise grid, ``python -m mjswarm.experiments.stress --noise``). A new beacon's frame holds its dropper's heading variance plus
 #: this; a revisit's :func:`frame_offset` errs by about as much.
 SCAN_FRAME_VAR = math.radians(0.9) ** 2
 
@@ -654,7 +654,7 @@ SCAN_FRAME_VAR = math.radians(0.9) ** 2
 def fuse_frames(delta_rad: float, robot_var: float, beacon_offset: float,
                 beacon_var: float) -> tuple[float, float, float, float]:
     """A scalar Kalman update of a robot's heading and a beacon's frame on a revisit
-    (ours, issue 27's frame fusion): ``(correction, robot variance after,
+    (ours: frame fusion): ``(correction, robot variance after,
     beacon offset after, beacon variance after)``, rad and rad^2.
 
     ``delta_rad`` is :func:`frame_offset` of the robot's measured angles onto the beacon's
@@ -665,7 +665,7 @@ def fuse_frames(delta_rad: float, robot_var: float, beacon_offset: float,
     has variance ``S = robot_var + beacon_var + SCAN_FRAME_VAR``:
 
     * the robot turns by ``k y``, ``k = robot_var / S``: fully onto the beacon's frame
-      when its own heading is much less sure (the old re-anchoring, ``k = 1``), hardly at
+      when its own heading is much less sure (plain re-anchoring, ``k = 1``), hardly at
       all when the beacon's is (a robot fresh from the root meeting a deep vertex);
     * the beacon's offset moves by ``(beacon_var / S) y`` towards the robot's frame, and
       its variance shrinks alike. Its stored angles never move (they name its edges in
@@ -674,7 +674,8 @@ def fuse_frames(delta_rad: float, robot_var: float, beacon_offset: float,
 
     The two errors are taken as independent (no cross-covariance is kept): a robot back at
     a vertex whose frame it took before shares part of its error with it, and the update
-    then trusts the pair a little too much (over issue 27's slip runs the robots' squared
+    then trusts the pair a little too much (over the noise grid's slip runs, ``python -m
+    mjswarm.experiments.stress --noise``, the robots' squared
     errors average 1.3 times their variance, the beacons' 1.0 times)."""
     s = robot_var + beacon_var + SCAN_FRAME_VAR
     y = delta_rad - beacon_offset

@@ -99,7 +99,7 @@ class Odometry:
 
     def calibrate(self, track_m: float, scans: int, exact_crossings: bool) -> None:
         """Take the effective track and the distance scale that ``track_m`` (m), the mean
-        of ``scans`` scans' effective tracks, calls for (ours, issue 27).
+        of ``scans`` scans' effective tracks, calls for (ours).
 
         Encoders that over-read their wheels' turn by a fraction ``e`` (wheel slip: the
         wheel spun more than it rolled) over-read a turn in place and a straight drive
@@ -114,18 +114,18 @@ class Odometry:
         The track: with ``exact_crossings`` (the line readings are noise-free enough for
         the line filter to pass single readings) a scan's crossings are placed to half a
         control tick, its over-read to about 0.05 %, as close as the floor's scrub is
-        known (``benchmarks/turn_over_read.py``), and the track is the scans' mean as it
-        always was. With noisy line readings one scan's over-read spreads 0.3 %, and a
+        known (``benchmarks/turn_over_read.py``), and the track is the scans' mean. With noisy line readings one scan's over-read spreads 0.3 %, and a
         mean below the scrub's is that noise alone: encoders never under-read (slip makes
         a wheel spin more than it rolls), so the track is the larger of the scans' mean
         and the scrub's, the most likely track that is not below it (the mean's
         maximum-likelihood estimate under that bound), never farther from the truth than
-        the mean. A lone robot whose first scan read its turn 0.53 % short took that for
-        its track and turned its heading 2.3 degrees at once (``fan:3:45@17``, 1 robot,
-        0.1 m/s, line noise 0.5 mm, kinematic, seed 1: 5.3 degrees at the end; 0.6 now). On
-        issue 27's sample the 28 runs with line noise alone end 2.31 degrees off on average
-        instead of 2.95 (21 better, 5 worse: the map's frame moves with every scan); slip
-        0.01's 56 runs and every run without line noise are unchanged. A mean above the
+        the mean. Without the bound, a lone robot whose first scan read its turn 0.53 %
+        short would take that for its track and turn its heading 2.3 degrees at once
+        (``fan:3:45@17``, 1 robot, 0.1 m/s, line noise 0.5 mm, kinematic, seed 1). On the
+        noise grid's sample (``python -m mjswarm.experiments.stress --noise --sample``) the
+        bound leaves most runs with line noise alone nearer the truth (not all: the map's
+        frame moves with every scan), and slip 0.01's runs and every run without line
+        noise as the mean alone leaves them. A mean above the
         scrub's is kept: a noisy scan that reads long cannot be told from slip 0.01's
         0.8 %, and a bar that also ignored means up to 2 standard errors above the scrub
         cost slip 0.01's robots up to 3.3 degrees of heading in that sample."""
@@ -145,7 +145,7 @@ class Odometry:
     @property
     def slip_sigma(self) -> float:
         """The spread (a fraction, one standard deviation) of one update's encoder
-        over-read about its mean, from the calibrated distance scale (ours, issue 27's
+        over-read about its mean, from the calibrated distance scale (ours, for
         frame fusion): an encoder that over-reads by ``|N(0, S)|`` over-reads by
         ``S sqrt(2 / pi)`` on average, which :meth:`calibrate` measures as
         ``distance_scale - 1``, and spreads ``S sqrt(1 - 2 / pi)`` about it. 0 while the
@@ -162,9 +162,9 @@ class Odometry:
         mean is calibrated out), so its variance is ``(r / b)^2 (dl^2 + dr^2) sigma^2``,
         summed over updates: for the Spark V (r 25 mm, b 0.12 m) at slip 0.05 a straight
         metre at 0.15 m/s and 50 Hz adds about (1.1 deg)^2, a scan's whole turn at 1 rad/s
-        (0.4 deg)^2. On issue 27's slip runs the heading's drift from one vertex call to
-        the next is 1.13 degrees rms against 0.99 modelled (1070 legs; along the lanes
-        alone 0.75 against 0.74)."""
+        (0.4 deg)^2. On the noise grid's slip runs (``python -m mjswarm.experiments.stress
+        --noise``) the heading's drift from one vertex call to the next is 1.13 degrees
+        rms against 0.99 modelled (1070 legs; along the lanes alone 0.75 against 0.74)."""
         k = self.cal.wheel_radius_m / self.track_m * self.slip_sigma
         return k * k * (self.wheel_sq - wheel_sq)
 

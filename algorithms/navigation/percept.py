@@ -132,8 +132,8 @@ class LineFilter:
     * the floor level (starting from the calibration's ``line_floor_m``) by an
       exponential average at ``FLOOR_RATE`` of the windows that read floor: in the
       dynamic tier the body sinks 0.46 mm into the floor, which left only 0.54 mm
-      between the floor and the fixed threshold (issue 27: 0.25 mm of noise stopped
-      robots within seconds).
+      between the floor and a fixed threshold, where 0.25 mm of noise stops robots
+      within seconds.
 
     A NaN reading (nothing within range) counts as the floor level.
     """

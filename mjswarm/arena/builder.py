@@ -1,4 +1,4 @@
-"""Arena spec -> MuJoCo world (issue 3, part 2).
+"""Arena spec -> MuJoCo world.
 
 Turns the geometry of :mod:`mjswarm.arena.geometry` (lane strips, vertex spokes,
 corridor walls) into floor strips and walls for :func:`mjswarm.core.world.world_spec`, adds a

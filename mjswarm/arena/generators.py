@@ -29,7 +29,7 @@ Every generator is a deterministic function of its arguments (randomness from
     ``random-graph:(E+1):E:SEED``: a random tree with E edges on the lattice.
 
 Generators beyond the square lattice (vertices whose edges are 45 to 120 degrees apart,
-for issue 13's stress grid). Where a length has a default it is the smallest multiple of
+for the stress grid, ``python -m mjswarm.experiments.stress``). Where a length has a default it is the smallest multiple of
 ``DEFAULT_STEP_M`` for which every rule of :mod:`mjswarm.arena.spec` holds, found by
 asking the validator, not by a formula:
 

@@ -70,7 +70,7 @@ SENSOR_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
 
 SENSING = ("auto", "grid", "mujoco")
 #: Robot count from which ``sensing="auto"`` casts rays on the grid (``mjswarm bench
-#: --sensing grid`` and ``--sensing mujoco`` measure the two; README, "Benchmark").
+#: --sensing grid`` and ``--sensing mujoco`` measure the two; ``docs/performance.md``).
 GRID_SENSING_MIN_ROBOTS = 32
 #: How far (m) grid sensing looks along a rangefinder that has no cutoff before it asks
 #: ``mj_ray``: beyond any line-sensor reading of an upright robot (0.02 m).

@@ -1,4 +1,4 @@
-"""Connectivity awareness on moving embodied robots (issue 6, part 4): the ground truth the
+"""Connectivity awareness on moving embodied robots: the ground truth the
 robots' beliefs are checked against (the radio's line of sight is
 :func:`mjswarm.core.radio.sight_blocker`).
 

@@ -143,7 +143,7 @@ class EmbodiedResult(ExplorationResult):
     reason: str | None = None
     #: relay missions the robots set out on (rule 6 of :mod:`algorithms.exploration.relay`)
     relay_trips: int = 0
-    #: vertices closed by a body stopped for good in their area (issue 30, item 3):
+    #: vertices closed by a body stopped for good in their area:
     #: ``{"vertex": v, "robot": R, "at_s": t}``, and every true edge outside the part
     #: reachable from the root without entering one, and not in the declared map:
     #: ``{"edge": [u, v], "why": text}`` (:func:`mjswarm.experiments.metrics.
@@ -168,11 +168,11 @@ def same_lane_bearing(range_m: float) -> float:
     robot on the edge's centre line, ``atan(LANE_OFFSET_M / 2 / range)`` (2.6 degrees at
     1 m). Robots on vertex centres stand on centre lines; one waiting on the centre of the
     vertex beyond the one a robot drives to (vertex entry) is no obstacle, and stopping
-    for it would wait for ever (issue 13, ``arena2`` with 4 robots: a robot waiting on v9
-    for v5 stopped the robot driving from v3 to v5). A robot on the opposite lane is
+    for it would wait for ever (``arena2`` with 4 robots: a robot waiting on v9 for v5
+    would stop the robot driving from v3 to v5). A robot on the opposite lane is
     twice as far off again. The rule gets its bearings in the lane's frame (the
     navigator's ``lane_bearings``: bearing + heading - lane direction), so a nose turned a
-    few degrees off the lane does not bring such a robot into the cone (issue 27)."""
+    few degrees off the lane does not bring such a robot into the cone."""
     return math.atan2(LANE_OFFSET_M / 2.0, range_m)
 
 

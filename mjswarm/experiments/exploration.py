@@ -1,4 +1,4 @@
-"""Embodied exploration: the graph strategies on MuJoCo robots (issue 5), as loop functions.
+"""Embodied exploration: the graph strategies on MuJoCo robots, as loop functions.
 
 Every robot is an :class:`~algorithms.exploration.explorer.Explorer` controller
 (navigator, exploration strategy, collision rule, vertex entry, optionally a
@@ -52,7 +52,7 @@ Choices it makes, beyond the paper:
   biconnected component of three or more with R1 in the radio graph; both are sampled
   five times a second into ``radio_belief_agreement``. Robots in the depot or failed
   are off the air.
-* **Exploration that stays connected** (``connectivity``, issue 17): a base station at
+* **Exploration that stays connected** (``connectivity``): a base station at
   the root joins the robots' radio (links need line of sight, as between robots); every
   robot keeps its tether (:mod:`algorithms.exploration.tether`) from a radio-ranging
   sensor (range and bearing of its radio neighbours); the base adopts, beats and floods
@@ -331,7 +331,7 @@ class EmbodiedExploration(LoopFunctions):
         truth = self.tether_truth
         true_edges = {tuple(sorted(e)) for e in self.spec.edges}
         closed, ended, unreachable = self.stations.closed, m.ended_because, []
-        # issue 30: a team cut off from its root completes with nobody declaring, its map
+        # a team cut off from its root completes with nobody declaring, its map
         # the union of the cut-off robots' maps (team_cut_off)
         cut_off = team_cut_off(self.roster, self.world.n, ended) if closed else None
         declared_map, makespan = m.declared_map, m.makespan

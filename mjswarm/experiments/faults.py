@@ -1,4 +1,4 @@
-"""Fault injection for embodied exploration (``mjswarm explore --fault``, issue 13).
+"""Fault injection for embodied exploration (``mjswarm explore --fault``).
 
 Forms (times in simulated seconds; robots numbered from 1, as in every output):
 

@@ -6,7 +6,7 @@ whenever the root is free: no launched robot that is still at work stands within
 ``ROOT_CLEAR_M`` of it, and (with vertex entry) no robot holds it. Each starts with
 compass heading 0 along the world's +x, the common reference direction of the
 incidence angles. A robot switched off while it waits is never launched, and neither is
-any robot once the root is closed (issue 30: a body stands in its area; the robots left
+any robot once the root is closed (a body stands in its area; the robots left
 in the depot are then done, :attr:`~mjswarm.experiments.metrics.Roster.unlaunched`).
 """
 

@@ -42,10 +42,10 @@ class Roster:
         #: stopped, declared, cut off, switched off or never to be launched
         self.finished: set[int] = set()
         self.failed: set[int] = set()  # switched off (faults)
-        #: robots cut off from the root that finished their part (issue 30): robot ->
+        #: robots cut off from the root that finished their part: robot ->
         #: (time s, the vertex it stands on, its map as pairs of beacon ids)
         self.cut_off: dict[int, tuple[float, str, tuple]] = {}
-        #: robots of the depot that can never be launched: the root closed (issue 30)
+        #: robots of the depot that can never be launched: the root closed
         self.unlaunched: set[int] = set()
         self.last_progress_s = 0.0
 
@@ -188,7 +188,7 @@ class ExplorationMetrics(LoopFunctions):
 
 
 def team_cut_off(roster: Roster, n_robots: int, ended: str) -> dict | None:
-    """The team's completion when no robot left can get to the root (issue 30), or
+    """The team's completion when no robot left can get to the root, or
     None. The root closed, or every robot that could still reach it failed: no robot
     can declare then (its reach never holds the root: ``incidence_matrix``'s rule), so
     the verdict is the experimenter's, as "all robots stopped" (``ended``) is: every
@@ -211,7 +211,7 @@ def reachable_part(edges: Iterable[tuple[str, str]],
                    closed: Mapping[str, tuple[int, float]],
                    mapped: Iterable[tuple[str, str]] = ()) -> tuple[set[tuple[str, str]],
                                                                     list[dict]]:
-    """Ground truth of a run with closed vertices (issue 30; ``closed``: vertex -> (robot
+    """Ground truth of a run with closed vertices (``closed``: vertex -> (robot
     index whose body closed it, time s), as the stations recorded them; ``sources``:
     where the team can still go from, and until when (s): the root until the end
     (``math.inf``), or each robot cut off from it where and when it finished its part).

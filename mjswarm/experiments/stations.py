@@ -24,11 +24,11 @@ edge) is granted as a whole: every robot in it gets its next vertex and leaves a
 usually arrives after the previous holder has left (leaving takes a turn and a
 sidestep; arriving, a whole edge), and otherwise waits where its lane's wall ends, clear
 of the vertex area, until that robot is in its corridor (:mod:`mjswarm.experiments.exploration`). Robots never wait behind one another on a lane
-either: a lane leads to one vertex, held by the one robot on it. This replaces the
-scheme of issue 5, where a robot asked for the vertex ahead from its lane: a robot
-stopped by the speed rule just after leaving (still holding its vertex) behind a robot
-waiting on the lane for a vertex whose holder was stopped the same way closed a cycle
-(issue 13: four robots on one edge of ``lattice:10x10``).
+either: a lane leads to one vertex, held by the one robot on it. Asking for the vertex
+ahead from the lane would deadlock: a robot stopped by the speed rule just after
+leaving (still holding its vertex) behind a robot waiting on the lane for a vertex whose
+holder was stopped the same way closes a cycle (four robots on one edge of
+``lattice:10x10``).
 
 **Robots that turn back** (rule 6's relays, ours) ask for the vertex behind them from a
 lane (``at`` None) and wait where that lane's wall ends. Such a robot holds nothing (it
@@ -38,21 +38,21 @@ unchanged. One wait is not the stations': a robot that asked from its corridor, 
 turned (too near the vertex behind for a U-turn), still stands on the lane that leads
 away from that vertex, and a robot leaving that vertex along the same edge is stopped
 behind it by the speed rule while it holds the vertex the first one waits for. That
-deadlock is not broken here; the team's stall verdict ends such a run (seen once, on
-``arena2`` with 4 robots at 2 m, while rule 6 was being built).
+deadlock is not broken here; the team's stall verdict ends such a run.
 
-A wait that closes through the speed rule (issue 30's dense-team grid; ``lattice:6x6``,
-8 robots, 0.15 m/s, seed 1, stalled at 934 s): R4, on its lane from ``v4_2`` to ``v4_3``
-(holding ``v4_3``, still leaving ``v4_2``), was held still by the speed rule for R5,
-which stood on the centre of ``v4_4``, the vertex beyond, and waited for ``v4_3``; R3
-waited where its lane's wall ends for ``v4_2`` to be clear, and five more robots waited on
-centres for vertices those held. Bearings carry no range: R5 stood 2.5 degrees off R4's
-estimate of its lane, inside the rule's 2.6 degree cone. The stations cannot see that
+A wait that closes through the speed rule (the dense-team grid, ``python -m
+mjswarm.experiments.stress --dense``; ``lattice:6x6``, 8 robots, 0.15 m/s, seed 1 stalls
+without the creep): R4, on its lane from ``v4_2`` to ``v4_3`` (holding ``v4_3``, still
+leaving ``v4_2``), is held still by the speed rule for R5, which stands on the centre of
+``v4_4``, the vertex beyond, and waits for ``v4_3``; R3 waits where its lane's wall ends
+for ``v4_2`` to be clear, and five more robots wait on centres for vertices those hold.
+Bearings carry no range: R5 stands 2.5 degrees off R4's estimate of its lane, inside the
+rule's 2.6 degree cone. The stations cannot see that
 wait; the robot breaks it (:meth:`~algorithms.exploration.explorer.Explorer._creep`: a
 robot held still on its lane for 5 s creeps on, guarded by its front IR, since vertex
 entry leaves nobody else on its lane).
 
-**Closed vertices** (issue 30, item 3: a body that cannot be passed). A robot that stops
+**Closed vertices** (ours: a body that cannot be passed). A robot that stops
 for good (a fault switches it off, it halts, or it is cut off from the root with its part
 finished) with its body in a vertex area, or in the stretch of its corridor still shared
 with the vertex's other edges (:func:`~mjswarm.arena.geometry.junction_depths`: edges

@@ -1,23 +1,23 @@
-"""The robustness stress grid (issue 13): embodied exploration beyond the paper's arenas.
+"""The robustness stress grid: embodied exploration beyond the paper's arenas.
 
 Arenas with vertices whose edges are 45-90 degrees apart, at arbitrary rotations (fans,
 wheels, hexagonal and triangular lattices, random planar graphs, rotated lattices and
 paper arenas), 1 to 10 robots, speeds from the paper's 0.05 m/s to the top speed 0.2
 m/s, several seeds. Every run must complete with the true map, no robot stopped and no
 robot-robot contact. ``python -m mjswarm.experiments.stress`` runs the grid on a process pool and
-prints its table (the one in README); ``tests/test_stress.py`` runs a fast
+prints its table (the one in ``docs/exploration.md``); ``tests/test_stress.py`` runs a fast
 representative of each failure class by default and the whole grid with ``-m slow``.
 
-The noise grid (issue 27, ``--noise``): one arena of each class at every speed, under
+The noise grid (``--noise``): one arena of each class at every speed, under
 line noise 0.5 mm, IR noise 2 mm, bearing noise 2 degrees and wheel slip 0.05, each alone
 and all together, in both physics tiers, two seeds; it adds the criterion that the
 robots' odometry heading stays within ``MAX_HEADING_ERROR_DEG`` of the truth.
 
-The dense-team grid (issue 30, ``--dense``): lattices, a hexagonal lattice and a random
+The dense-team grid (``--dense``): lattices, a hexagonal lattice and a random
 planar graph with one robot for every 7, 5 and 4 edges, at 0.15 and 0.2 m/s, three seeds;
 every run must pass as the stress grid's do.
 
-The dead-robot grid (issue 30, ``--dead``): one robot fails (``--fault robot:I@T``) on
+The dead-robot grid (``--dead``): one robot fails (``--fault robot:I@T``) on
 trees, the paper's arenas, a lattice and a random planar graph, teams of 2, 4 and 8,
 fault times from before the launch to a whole robot's share of the work, speeds
 0.05-0.2 m/s in turn, both physics tiers. A run passes when it ends completed with the
@@ -41,8 +41,8 @@ from mjswarm.arena import ArenaSpec, load_arena, parse_arena_spec
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedResult, explore_embodied
 from mjswarm.experiments.faults import parse_fault
 
-#: Issue 13's first report: one robot arriving at v1, whose edges are 67.5 degrees
-#: apart, was carried out along a neighbouring spoke.
+#: A fan whose vertex v1 has edges 67.5 degrees apart: a robot arriving at v1 must not be
+#: carried out along a neighbouring spoke.
 ISSUE_13_FAN = {
     "name": "issue13-fan", "root": "v0",
     "vertices": {"v1": [0, 0], "v0": [0.3515, 0.8485], "v2": [-0.8485, -0.3515],
@@ -78,8 +78,8 @@ class Noise:
         return ", ".join(p for p in parts if p) or "none"
 
 
-#: Issue 27's noise levels: each at its largest alone, then all together.
-#: The wheel slip the noise grid asks for (issue 27).
+#: The noise levels: each at its largest alone, then all together.
+#: The wheel slip the noise grid asks for.
 GRID_SLIP = 0.05
 
 
@@ -100,11 +100,11 @@ NOISE_TEAMS = (1, 4)
 #: tier at the paper's speed and the top speed, teams of 4 (140 runs).
 SAMPLE_SPEEDS_M_S = (0.05, 0.2)
 SAMPLE_TEAMS = (4,)
-#: The noise grid's heading criterion (deg): issue 27's "heading error within 5 degrees".
+#: The noise grid's heading criterion (deg): heading error within 5 degrees.
 MAX_HEADING_ERROR_DEG = 5.0
 
 
-#: Issue 30's dense teams: arenas, team sizes as edges per robot, speeds (m/s).
+#: The dense teams: arenas, team sizes as edges per robot, speeds (m/s).
 DENSE_ARENAS = ("lattice:5x5", "lattice:6x6", "lattice:8x8", "hex:3x3", "random-planar:24:3")
 DENSE_EDGES_PER_ROBOT = (7, 5, 4)
 DENSE_SPEEDS_M_S = (0.15, 0.2)
@@ -112,7 +112,7 @@ DENSE_SPEEDS_M_S = (0.15, 0.2)
 DENSE_SAMPLE = {"edges_per_robot": (5, 4), "speeds": (0.2,), "seeds": (0,)}
 
 
-#: Issue 30's dead-robot grid: arenas, teams, speeds (m/s, taken in turn) and fault times
+#: The dead-robot grid: arenas, teams, speeds (m/s, taken in turn) and fault times
 #: as fractions of a robot's share of the work (its ``E / K`` edges, each a traversal of
 #: the mean edge at the run's speed and a scan's full turn at 1 rad/s).
 DEAD_ARENAS = ("tree3", "tree4", "arena1", "arena2", "lattice:4x4", "random-planar:12:2")
@@ -160,14 +160,14 @@ def grid(arenas=ARENAS, speeds=SPEEDS_M_S, teams=TEAMS, seeds=(0,)) -> list[Stre
 
 def noise_grid(arenas=NOISE_ARENAS, speeds=SPEEDS_M_S, teams=NOISE_TEAMS, noises=NOISES,
                physics=PHYSICS, seeds=(0, 1)) -> list[StressRun]:
-    """Issue 27's grid: every arena class at every speed under every noise, both tiers."""
+    """The noise grid: every arena class at every speed under every noise, both tiers."""
     return [StressRun(arena, k, v, s, noise, tier) for arena in arenas for k in teams
             for v in speeds for noise in noises for tier in physics for s in seeds]
 
 
 def dense_grid(arenas=DENSE_ARENAS, edges_per_robot=DENSE_EDGES_PER_ROBOT,
                speeds=DENSE_SPEEDS_M_S, seeds=(0, 1, 2)) -> list[StressRun]:
-    """Issue 30's dense-team grid: ``E // n`` robots for each ``n`` of ``edges_per_robot``
+    """The dense-team grid: ``E // n`` robots for each ``n`` of ``edges_per_robot``
     (E: the arena's edges), at every speed and seed."""
     runs = []
     for arena in arenas:
@@ -179,7 +179,7 @@ def dense_grid(arenas=DENSE_ARENAS, edges_per_robot=DENSE_EDGES_PER_ROBOT,
 
 def dead_grid(arenas=DEAD_ARENAS, teams=DEAD_TEAMS, fractions=DEAD_FRACTIONS,
               physics=PHYSICS, seeds=(0,)) -> list[StressRun]:
-    """Issue 30's dead-robot grid: in every arena, team (no larger than the arena's edge
+    """The dead-robot grid: in every arena, team (no larger than the arena's edge
     count), fault time, tier and seed, robot ``1 + (cell number) mod K`` fails; speeds
     go round ``DEAD_SPEEDS_M_S`` cell by cell."""
     runs = []
@@ -276,7 +276,7 @@ def noise_table(rows: list[tuple[StressRun, EmbodiedResult, float]]) -> str:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m mjswarm.experiments.stress",
-        description="Run issue 13's robustness stress grid and print its table (markdown); "
+        description="Run the robustness stress grid and print its table (markdown); "
                     "exit status 1 if any run failed (the failures are listed).")
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                         help="processes (default: all cores)")
@@ -285,15 +285,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seeds", type=int, default=None,
                         help="seeds 0..N-1 (default: 1; the noise grid: 2)")
     parser.add_argument("--noise", action="store_true",
-                        help="run issue 27's noise grid instead (--arenas defaults to its "
+                        help="run the noise grid instead (--arenas defaults to its "
                              "classes; every speed, noise level and physics tier)")
     parser.add_argument("--log", type=argparse.FileType("a"), default=None, metavar="FILE",
                         help="append one line per run to FILE as it is done")
     parser.add_argument("--dense", action="store_true",
-                        help="run issue 30's dense-team grid instead (one robot for every "
+                        help="run the dense-team grid instead (one robot for every "
                              "7, 5 and 4 edges, 0.15 and 0.2 m/s, three seeds: 90 runs)")
     parser.add_argument("--dead", action="store_true",
-                        help="run issue 30's dead-robot grid instead (one robot fails; "
+                        help="run the dead-robot grid instead (one robot fails; "
                              "trees, paper arenas, a lattice, a random planar graph; teams "
                              "of 2, 4 and 8; both physics tiers)")
     parser.add_argument("--sample", action="store_true",

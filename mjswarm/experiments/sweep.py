@@ -1,4 +1,4 @@
-"""Parameter sweeps: a grid of exploration runs, in parallel, resumable (issue 8 part 3).
+"""Parameter sweeps: a grid of exploration runs, in parallel, resumable.
 
 A sweep is the product arenas x robot counts x strategies x seeds x radio ranges x
 connectivity constraints in one world (``graph``, :mod:`mjswarm.experiments.radio_exploration`, or
