@@ -4,7 +4,7 @@ A :class:`BatchController` steps every robot of a team in one call (VMAS's agent
 ARGoS's sense-all / control-all phases without a Python step per robot): the world hands
 it one :class:`Readings`, a structure of arrays with a row per robot stepped this tick,
 and applies the one :class:`BatchCommand` it answers with. Reflexes (line following,
-odometry, seed 003's collision rule over pair arrays) are array operations; per-robot
+odometry, Nagavarapu et al.'s collision rule over pair arrays) are array operations; per-robot
 decisions stay event-driven inside the team.
 
 Readings hold what the rows of :class:`~algorithms.robot.Observation` hold (the same

@@ -1,4 +1,4 @@
-"""Seed 003's speed rule (eqs. 17, 27, 33) for a whole team in one compiled call.
+"""Nagavarapu et al.'s speed rule (eqs. 17, 27, 33) for a whole team in one compiled call.
 
 :class:`BatchCollisionRule` keeps, per pair ``(R_k, R_p)`` in view, what
 :class:`~algorithms.collision.CollisionRule` keeps per robot ``R_p`` (the last

@@ -1,4 +1,4 @@
-"""The benchmark's robot: a line follower with seed 003's speed rule and a radio
+"""The benchmark's robot: a line follower with Nagavarapu et al.'s speed rule and a radio
 heartbeat, the per-tick work of a team that senses, decides and talks every tick
 (:mod:`mjswarm.experiments.bench`), as one robot (:class:`BenchRobot`) and as a batched
 team (:class:`BenchTeam`) that commands what every one of its robots would."""
@@ -21,7 +21,7 @@ HEARTBEAT = (Message("heartbeat"),)
 
 class BenchRobot(Controller):
     """The bench's controller: hears its inbox and broadcasts a heartbeat every tick,
-    sets its speed with the seed-003 speed rule from its bearings and steers towards the
+    sets its speed with Nagavarapu et al.'s speed rule from its bearings and steers towards the
     darker side with a proportional line follower on its own line sensors."""
 
     def __init__(self, rule: CollisionRule, line_sensor_height_m: float) -> None:

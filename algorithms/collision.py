@@ -1,4 +1,4 @@
-"""The bearing-rate speed-change collision rule of seed 003, Sec. 4.
+"""The bearing-rate speed-change collision rule of Nagavarapu et al., Sec. 4.
 
 Each robot ``R_k`` sees the bearings ``beta_kp`` of the robots ``R_p`` in its field of
 view and changes only its own linear speed ``S_k``:
@@ -72,7 +72,7 @@ import operator
 from collections import deque
 from dataclasses import dataclass, field
 
-#: ``S``, the initial speed of seed 003's experiments (Sec. 5: 5 cm/s), m/s: the default
+#: ``S``, the initial speed of Nagavarapu et al.'s experiments (Sec. 5: 5 cm/s), m/s: the default
 #: speed of embodied runs.
 PAPER_SPEED_M_S = 0.05
 #: A rate fit decides only when its standard error is at most ``zero_rate`` over this:

@@ -1,7 +1,7 @@
 """Velocity tracking for a differential-drive (unicycle) robot.
 
 A pure function: pose in, ``(v, omega)`` out. It turns the planar velocity commands of the
-connectivity papers (seed 001's ``u_i``, seed 002's "drive towards") into what a
+connectivity papers (Kobayashi et al.'s ``u_i``, Ahmadi & Stone's "drive towards") into what a
 differential-drive robot can do: turn towards the commanded direction and drive forward
 at the commanded speed scaled by ``cos`` of the heading error (never backwards), within
 its speed and turn-rate limits.

@@ -14,7 +14,7 @@ robot could have in that tick:
   shows (an LED colour, or the data byte of a range-and-bearing board as on ARGoS's
   e-puck), keyed by the id the sensor reports;
 * the radio messages it received and its current radio neighbours (link-layer
-  knowledge, seed 004's MANET layer);
+  knowledge, Le et al.'s MANET layer);
 * the beacon handle of the vertex whose centre it stands on, else None;
 * in the graph worlds, where robots have no bodies, what a scan of that vertex would
   measure (:class:`VertexSense`), and in the radio graph world what its odometer and
@@ -54,7 +54,7 @@ class Detection(NamedTuple):
 class VertexSense(NamedTuple):
     """What a robot of a graph world senses of the vertex it stands on (a perfect scan):
     the incidence angles of its edges (rad, counter-clockwise from the common +x, in
-    (0, 2*pi], seed 003 section 2) and the angle, here, of the edge it arrived by (None:
+    (0, 2*pi], Nagavarapu et al. section 2) and the angle, here, of the edge it arrived by (None:
     it has not moved since its last call, as at the start or after idling)."""
 
     angles_rad: tuple[float, ...]

@@ -1,7 +1,7 @@
 """The connected-exploration table: the price of staying connected, in the graph world.
 
 For each arena, team size K and radio range R (m), one run per constraint (``none``,
-``connected``, ``biconnected``; seed 003's incidence-DFS, canonical tie rules) in
+``connected``, ``biconnected``; Nagavarapu et al.'s incidence-DFS, canonical tie rules) in
 :class:`~mjswarm.worlds.radiograph.RadioGraphWorld`; prints a markdown table: makespan
 (time units, or the verdict), total traversals, radio messages and relay trips, with
 the unconstrained run's shares of ticks in which every robot reached the base and the

@@ -1,6 +1,6 @@
 """Run one experiment from Python and plot its result.
 
-Seed 002's S-coverage experiment (biconnected add / remove) on kinematic points, for both
+Ahmadi & Stone's S-coverage experiment (biconnected add / remove) on kinematic points, for both
 communication ranges the paper reports, plotted episode by episode against the paper's
 means.
 
@@ -42,7 +42,7 @@ for cr, color in ((2.0, "tab:blue"), (4.0, "tab:orange")):
     print(f"cr {cr:g}: mean S-coverage {result.mean_coverage:.1%} over {args.episodes} episodes")
 ax.set_xlabel("episode")
 ax.set_ylabel("S-coverage (%)")
-ax.set_title(f"Biconnected add / remove (seed 002), {args.world} world, seed {args.seed}")
+ax.set_title(f"Biconnected add / remove (Ahmadi & Stone), {args.world} world, seed {args.seed}")
 ax.legend(fontsize=8)
 fig.tight_layout()
 fig.savefig(args.out)

@@ -9,7 +9,7 @@ import numpy as np
 
 from mjswarm.worlds.loop import LoopFunctions
 
-#: Seed 003 Fig. 9 (DESIGN notes): coordinates that reproduce every angle of I10(v6).
+#: Nagavarapu et al. Fig. 9 (DESIGN notes): coordinates that reproduce every angle of I10(v6).
 FIG9_POS = {
     "v1": (0, 1), "v2": (1, 1), "v5": (2, 1), "v7": (3, 1), "v3": (0, 0),
     "v4": (1, 0), "v6": (2, 0), "v8": (3, 0), "v9": (4, 0), "v10": (5, 0),

@@ -53,7 +53,7 @@ def test_cli_export_of_a_bad_spec_writes_nothing(tmp_path, capsys):
 @pytest.mark.parametrize("name", ["arena1", "arena2", "fig9"])
 def test_ir_sees_walls_on_edges_and_none_at_vertices(name):
     """Robots on every lane's midpoint see their left wall; robots on every vertex centre,
-    in every direction, see nothing (seed 003 Sec. 5: vertex = absence of obstacles)."""
+    in every direction, see nothing (Nagavarapu et al. Sec. 5: vertex = absence of obstacles)."""
     spec = load_arena(name)
     on_lanes = []
     for strip in lane_strips(spec):

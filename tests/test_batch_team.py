@@ -1,4 +1,4 @@
-"""The batched robot type against the per-robot one on the same observations: seed 003's
+"""The batched robot type against the per-robot one on the same observations: Nagavarapu et al.'s
 speed rule over pair arrays, the bench's team, the radio's batched send and receive, and
 the batched loop (``mjswarm bench``'s) at 1000 robots."""
 

@@ -1,4 +1,4 @@
-"""Seed 002's add / remove episodes: the team's radio graph stays biconnected (networkx on
+"""Ahmadi & Stone's add / remove episodes: the team's radio graph stays biconnected (networkx on
 ground truth), the robots' tables agree, and the CLI reports mean_coverage."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Seed 002's geometry: union area, MOVE, Theorem 1, region choice and the leader's d,
+"""Ahmadi & Stone's geometry: union area, MOVE, Theorem 1, region choice and the leader's d,
 checked against closed forms, grids, networkx and brute force on seeded random cases."""
 
 from __future__ import annotations

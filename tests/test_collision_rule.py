@@ -1,4 +1,4 @@
-"""The bearing-rate collision rule (seed 003 Sec. 4) and the bearing sensor."""
+"""The bearing-rate collision rule (Nagavarapu et al. Sec. 4) and the bearing sensor."""
 
 from __future__ import annotations
 

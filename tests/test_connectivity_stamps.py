@@ -1,4 +1,4 @@
-"""Ahmadi & Stone's stamped-message biconnectivity check (seed 002), against networkx."""
+"""Ahmadi & Stone's stamped-message biconnectivity check (Ahmadi & Stone), against networkx."""
 
 from __future__ import annotations
 
@@ -106,7 +106,7 @@ def test_cr_and_dcr_lists_of_the_initiator_and_its_neighbours(seed):
 
 
 def figure1():
-    """Seed 002 Figure 1 (drawn from its caption): v joins two loops, v is a cut robot."""
+    """Ahmadi & Stone Figure 1 (drawn from its caption): v joins two loops, v is a cut robot."""
     return edge_team([("v", "a"), ("a", "b"), ("b", "v"), ("v", "c"), ("c", "d"), ("d", "v")])
 
 

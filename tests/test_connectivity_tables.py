@@ -1,4 +1,4 @@
-"""Le et al.'s connectivity tables (seed 004): paths, knowledge, updates, the check."""
+"""Le et al.'s connectivity tables (Le et al.): paths, knowledge, updates, the check."""
 
 from __future__ import annotations
 
@@ -150,7 +150,7 @@ def test_reference_as_the_cut_robot_is_found():
 
 def test_two_robots_and_one_robot():
     pair = Team(positions={"a": (0.0, 0.0), "b": (0.5, 0.0)})
-    assert run_check(pair, "tables", range_m=1.0).biconnected is False  # as in seed 002
+    assert run_check(pair, "tables", range_m=1.0).biconnected is False  # as in Ahmadi & Stone
     alone = Team(positions={"a": (0.0, 0.0)})
     result = run_check(alone, "tables", range_m=1.0)
     assert (result.connected, result.biconnected, result.articulation_points) == (True, False, [])

@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parent.parent
 #: Words of a development log: numbered issues, sessions and stages, commit references,
 #: "(was: ...)" asides.
 HISTORY = re.compile(r"\b(issues? #?\d+|sessions? \d+|stage \d+|commit [0-9a-f]{7,})\b"
-                     r"|\(was[:,]|\bwas: |\bseed 00\d\b", re.IGNORECASE)
+                     r"|(?<!\w)\(was[:,]|\bwas: |\bseed 00\d\b", re.IGNORECASE)
 
 #: What users read: the front page, the manual, the code's docstrings and help texts.
 READ_BY_USERS = ("README.md", "CHANGELOG.md", "docs", "algorithms", "mjswarm", "examples",

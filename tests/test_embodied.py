@@ -1,5 +1,5 @@
 """Embodied exploration: the graph strategies on MuJoCo robots with their own
-sensors and seed 003's collision rule. Fast checks by default; the 20-scenario sweeps
+sensors and Nagavarapu et al.'s collision rule. Fast checks by default; the 20-scenario sweeps
 (with and without collision avoidance) are marked slow."""
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ def truth(arena: str) -> list[tuple[str, str]]:
 
 @pytest.mark.parametrize("arena,robots", [("arena1", 2), ("arena2", 4)])
 def test_paper_arenas_complete_with_the_true_map(arena, robots):
-    """Seed 003 Sec. 5: arena 1 with two robots, arena 2 with four, at 5 cm/s."""
+    """Nagavarapu et al. Sec. 5: arena 1 with two robots, arena 2 with four, at 5 cm/s."""
     result = explore_embodied(load_arena(arena), robots, seed=0)
     assert result.completed
     assert result.map_edges == truth(arena) and result.map_correct

@@ -1,4 +1,4 @@
-"""Seed 003's worked example (section 5, Fig. 9): two robots on the 10-vertex, 12-edge graph."""
+"""Nagavarapu et al.'s worked example (section 5, Fig. 9): two robots on the 10-vertex, 12-edge graph."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from mjswarm.worlds.graphworld import GraphWorld
 
 PI = math.pi
 
-#: I10(v6) as printed (seed 003, section 5): rows v6 v5 v4 v3 v2 v1.
+#: I10(v6) as printed (Nagavarapu et al., section 5): rows v6 v5 v4 v3 v2 v1.
 PAPER_EDGES = ["e56", "e46", "e34", "e13", "e25", "e24", "e12", "e68", "e57"]
 PAPER_I10_V6 = {
     "v6": [-PI / 2, -PI, 0, 0, 0, 0, 0, 2 * PI, 0],

@@ -1,4 +1,4 @@
-"""The modified incidence matrix (seed 003 section 2, Algorithms 1 and 2), beacon ids and
+"""The modified incidence matrix (Nagavarapu et al. section 2, Algorithms 1 and 2), beacon ids and
 angle helpers, checked against brute force and networkx on many seeded random cases."""
 
 from __future__ import annotations

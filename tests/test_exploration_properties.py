@@ -1,5 +1,5 @@
 """Every strategy on many seeded random trees and planar graphs, K = 1..8, checked against
-networkx (true edge set, eccentricity of the root) and against seed 003's claims."""
+networkx (true edge set, eccentricity of the root) and against Nagavarapu et al.'s claims."""
 
 from __future__ import annotations
 
@@ -101,7 +101,7 @@ def test_proposition_2_at_most_e_steps_on_trees_with_two_or_more_robots(trees):
 
 def test_baselines_known_tree_bounds(trees):
     """MR-DFS with one robot is single-robot DFS (exactly 2E); MR-DFS and flooding with two
-    robots take at most E + r (seed 003 section 6)."""
+    robots take at most E + r (Nagavarapu et al. section 6)."""
     for (seed, name, k), (g, root, r) in trees.items():
         e, radius = g.number_of_edges(), nx.eccentricity(g, root)
         if name == "mr-dfs" and k == 1:
@@ -135,7 +135,7 @@ def test_literal_reselection_breaks_proposition_2_on_a_star():
 
 @pytest.mark.parametrize("root", ["v0_0", "v0_1"])
 def test_lattice_4x4_five_robots_proposed_beats_mr_dfs(root):
-    """Seed 003 section 6: 11 (proposed) vs 16 (MR-DFS); the paper does not say where the
+    """Nagavarapu et al. section 6: 11 (proposed) vs 16 (MR-DFS); the paper does not say where the
     robots start: the corner v0_0 and the boundary vertex next to it, v0_1. MR-DFS records
     simultaneous arrivals before anyone decides; an independent implementation
     of that model gets 20 from the corner, as ours does."""

@@ -1,4 +1,4 @@
-"""Acute Angle Test and Algorithm 2 (seed 001) against the centrally computed Gabriel graph."""
+"""Acute Angle Test and Algorithm 2 (Kobayashi et al.) against the centrally computed Gabriel graph."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Seed 001's role switching (Algorithm 1), recovery and the patrol mission."""
+"""Kobayashi et al.'s role switching (Algorithm 1), recovery and the patrol mission."""
 
 from __future__ import annotations
 

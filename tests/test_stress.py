@@ -32,7 +32,7 @@ from mjswarm.experiments.stress import (
 @pytest.mark.parametrize("run", [
     # 1. a vertex with edges 67.5 degrees apart: the approach was captured by a
     #    neighbouring spoke's inner end
-    StressRun("issue13-fan", 1, 0.05, 0),
+    StressRun("narrow-fan", 1, 0.05, 0),
     # 1. the validator's minimum, 45 degrees, at the top speed
     StressRun("fan:3:45@17", 1, 0.2, 0),
     # 2. 0.15 m/s: the speed rule's sudden stop pitched the body onto a phantom lane
@@ -47,14 +47,14 @@ def test_failure_class_representatives(run):
 
 
 def test_grid_leaves_out_teams_larger_than_the_arena():
-    runs = grid(arenas=("issue13-fan",), speeds=(0.1,), teams=(1, 4, 10))
+    runs = grid(arenas=("narrow-fan",), speeds=(0.1,), teams=(1, 4, 10))
     assert [r.robots for r in runs] == [1]  # 3 edges
 
 
 def test_table_counts_what_it_ran():
-    rows = run_grid([StressRun("issue13-fan", 1, 0.2, 0)], workers=1)
+    rows = run_grid([StressRun("narrow-fan", 1, 0.2, 0)], workers=1)
     text = table(rows)
-    assert "| `issue13-fan` | 1 | 1 | 1 | 0 | 0 |" in text
+    assert "| `narrow-fan` | 1 | 1 | 1 | 0 | 0 |" in text
 
 
 #: Dense teams at the top speed, one robot for every 5 edges, where a robot on its lane
@@ -199,7 +199,7 @@ def test_the_sample_covers_every_class_noise_and_tier_at_both_ends_of_the_speeds
 
 
 def test_noise_table_counts_the_heading_criterion():
-    run = StressRun("issue13-fan", 1, 0.2, 0, Noise(ir_m=0.002), "kinematic")
+    run = StressRun("narrow-fan", 1, 0.2, 0, Noise(ir_m=0.002), "kinematic")
     rows = [(run, run.run(), 1.0)]
     assert "| IR 2 mm | kinematic | 1 | 1 | 1 | 0 | 0 |" in noise_table(rows)
 

@@ -1,9 +1,9 @@
-"""Ahmadi & Stone (seed 002): distributed biconnectivity check with stamped messages.
+"""Ahmadi & Stone: distributed biconnectivity check with stamped messages.
 
 Robots pass stamped messages ``(T, (S))`` (Definition 6): a robot that receives a
 biconnectivity-type message not yet stamped by itself appends its id and broadcasts it
 (Algorithm 1, :func:`stamp_relay`). So every simple path of the robot graph is walked by a
-message, which is why the worst case is factorial (seed 002: "(n - 1)! messages in each
+message, which is why the worst case is factorial (Ahmadi & Stone: "(n - 1)! messages in each
 time period" per robot).
 
 * CR-FILL fills CR_R, the robots connected to R: every id stamped on a received "CR"
@@ -84,7 +84,7 @@ def dcr_members(stamps: tuple, robot_id: Hashable) -> tuple:
 
 
 class BiconnectivityCheck:
-    """One robot's part in one biconnectivity check (Algorithms 1-3 of seed 002).
+    """One robot's part in one biconnectivity check (Algorithms 1-3 of Ahmadi & Stone).
 
     Args:
         robot_id: this robot's unique id (Assumption 3).

@@ -1,4 +1,4 @@
-"""Le et al. (seed 004): connectivity tables of access paths to a reference robot.
+"""Le et al.: connectivity tables of access paths to a reference robot.
 
 An *access path* of robot R (Definition 1) is a path from one of R's neighbours, its
 *access robot*, to the reference robot that avoids R. It is stored as the tuple
@@ -29,7 +29,7 @@ Choices, where the paper is silent or contradicts itself:
   the true set of single points of failure between R and the reference (proof sketch in
   :meth:`ConnectivityTable.critical_robots`), so the check below is exact. Every robot
   forwards at most n - 1 paths: O(n^2) messages in all, the paper's bound.
-* **Forward-two variant** (``max_forwards=2``, seed 004 section 5, [LBSM09]): store all,
+* **Forward-two variant** (``max_forwards=2``, Le et al. section 5, [LBSM09]): store all,
   forward at most two: the first path and then the first one internally disjoint with it
   (in general, with a budget of k the last forward must empty the shared set). At most 2n
   messages. Its verdicts are sound but can miss: a robot with two disjoint paths may not
@@ -46,7 +46,7 @@ Choices, where the paper is silent or contradicts itself:
   Link-Broken carries the tick of the break, and a robot deletes only paths that crossed
   the link no later than that. A path heard again keeps its newest hop times and, if it
   was forwarded, is announced again.
-* **Neighbours at the first tick** are the initial network (seed 004 assumes the robots
+* **Neighbours at the first tick** are the initial network (Le et al. assumes the robots
   start together); only later changes trigger exchange or Link-Broken.
 """
 
@@ -115,11 +115,11 @@ def _canonical(ids: Iterable[Hashable]) -> list[Hashable]:
 
 
 class ConnectivityTable:
-    """One robot's connectivity table and its upkeep (seed 004, Algorithm 1 and section 4).
+    """One robot's connectivity table and its upkeep (Le et al., Algorithm 1 and section 4).
 
     Args:
         robot_id: this robot's id.
-        reference: the reference robot's id (chosen beforehand, seed 004 section 3).
+        reference: the reference robot's id (chosen beforehand, Le et al. section 3).
         max_forwards: None for the base algorithm, 2 for the forward-two variant.
     """
 
@@ -178,7 +178,7 @@ class ConnectivityTable:
         return frozenset.intersection(*(interior(p) for p in self._paths))
 
     def is_doubly_connected(self) -> bool:
-        """Two internally disjoint paths to the reference (seed 002 Definition 3).
+        """Two internally disjoint paths to the reference (Ahmadi & Stone Definition 3).
 
         True iff at least two paths are stored and no robot is on all of them.
         """
@@ -341,12 +341,12 @@ def _combine(reports: Iterable[Report]) -> Report:
 class TableCheck:
     """The biconnectivity check the tables give, gathered at the reference robot.
 
-    Seed 004 calls the team biconnected when every robot has two internally disjoint
-    access paths; that alone misses a reference that is itself a cut robot (seed 002,
+    Le et al. calls the team biconnected when every robot has two internally disjoint
+    access paths; that alone misses a reference that is itself a cut robot (Ahmadi & Stone,
     Figure 1), so the check adds: the reference's neighbours are all connected without
     the reference (the merged :meth:`ConnectivityTable.last_hops`). The paper does not say
     how robots learn the team's verdict; we gather it up the tree of first access paths
-    (each robot's oldest path's access robot is its parent), timed like seed 002: tables
+    (each robot's oldest path's access robot is its parent), timed like Ahmadi & Stone: tables
     are complete after N - 1 ticks, a robot at depth h (length of its first path) reports
     at tick 2N - 1 - h, and the reference decides at tick 2N - 1 (ticks counted from each
     robot's first tick; all robots start together). That adds n - 1 messages. One object

@@ -1,4 +1,4 @@
-"""Graph exploration minds: seed 003's incidence-matrix multi-robot DFS and the baselines
+"""Graph exploration minds: Nagavarapu et al.'s incidence-matrix multi-robot DFS and the baselines
 it is compared with (MR-DFS, BFS, LRV, flooding), all behind one interface
 (:class:`~algorithms.exploration.base.Strategy`).
 """

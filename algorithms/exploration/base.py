@@ -4,12 +4,12 @@ A strategy never sees true vertex ids nor the graph. At each vertex arrival the 
 calls :meth:`Strategy.on_vertex` with
 
 * ``beacon``: a :class:`Beacon` handle for the vertex the robot stands on, readable and
-  writable only during that call. The world owns one beacon per vertex (seed 003 drops a
+  writable only during that call. The world owns one beacon per vertex (Nagavarapu et al. drops a
   beacon at the first visit; the experiments emulate it with a central station) and never
   looks inside ``beacon.data``; it only reads ``beacon.id`` to map the strategy's beacon
   names to arena vertices for metrics.
 * ``angles``: the incidence angles of the edges at this vertex as the robot measured them,
-  radians counter-clockwise from the common +x reference, in (0, 2*pi] (seed 003 section 2:
+  radians counter-clockwise from the common +x reference, in (0, 2*pi] (Nagavarapu et al. section 2:
   "the zero angle is represented by 2*pi"). Exact in the graph world; a few degrees off on
   embodied robots, so strategies match angles by nearest value within
   :data:`ANGLE_TOLERANCE` (edges at a vertex are at least 45 degrees apart).
@@ -21,7 +21,7 @@ It answers with a :class:`Decision`: leave along the edge at ``angle``, ``DONE``
 later with ``arrived_by=None``) or, only where vertices close (a body that cannot be passed), ``CUT_OFF``.
 
 Robots that arrive at one vertex at the same time are handled one after another, each
-seeing the beacon as the previous one left it, in *descending* robot index. Seed 003's
+seeing the beacon as the previous one left it, in *descending* robot index. Nagavarapu et al.'s
 Fig. 9 run fixes that order: its 10th update is R1 reaching v6 at the 5th step, so R2's
 update of each step comes first, and at v4 (both robots arrive at step 2) only R2-first
 reproduces the printed vertex sequences.
@@ -73,9 +73,9 @@ def go(angle: float) -> Decision:
 class Beacon:
     """A vertex's beacon as the robot sees it during one call.
 
-    ``id`` is ``None`` until the first visitor drops the beacon and names it (seed 003:
+    ``id`` is ``None`` until the first visitor drops the beacon and names it (Nagavarapu et al.:
     robot R1 names its beacons a1, a2, ...; see :mod:`algorithms.exploration.beacon_ids`).
-    ``data`` is whatever the strategy keeps there (for seed 003, the incidence matrix).
+    ``data`` is whatever the strategy keeps there (for Nagavarapu et al., the incidence matrix).
     ``frame`` is what an embodied robot keeps there of the frame its stored angles are in
     (the frame fusion of :func:`~algorithms.navigation.navigator.fuse_frames`): ``(offset, variance)``, how far (rad) the robots
     believe those angles lie from the common frame and how sure (rad^2); ``None`` until
@@ -214,7 +214,7 @@ class Strategy(ABC):
 
 
 def normalize_angle(angle: float) -> float:
-    """``angle`` (radians) mapped into (0, 2*pi], with 0 represented by 2*pi (seed 003)."""
+    """``angle`` (radians) mapped into (0, 2*pi], with 0 represented by 2*pi (Nagavarapu et al.)."""
     a = math.fmod(angle, TWO_PI)
     if a <= 0.0:
         a += TWO_PI
@@ -246,7 +246,7 @@ def ccw_from(reference: float, angles: Sequence[float]) -> list[float]:
 
     An angle equal to the reference comes last (a full turn). This is the preference
     order of a robot's own new edges at a vertex (reference: the edge it arrived by; +x,
-    i.e. 2*pi, at the root), which reproduces seed 003's Fig. 9 run (DESIGN notes).
+    i.e. 2*pi, at the root), which reproduces Nagavarapu et al.'s Fig. 9 run (DESIGN notes).
     """
     def turn(a: float) -> float:
         d = (a - reference) % TWO_PI

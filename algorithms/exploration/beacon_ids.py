@@ -1,4 +1,4 @@
-"""Beacon names as in seed 003 section 3: robot R1 names its beacons a1, a2, a3, ...,
+"""Beacon names as in Nagavarapu et al. section 3: robot R1 names its beacons a1, a2, a3, ...,
 robot R2 b1, b2, ..., and so on.
 
 The paper stops at the alphabet. Beyond 26 robots the letters continue in bijective

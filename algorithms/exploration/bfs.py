@@ -1,6 +1,6 @@
-"""Multi-robot breadth-first exploration, the BFS baseline of seed 003 (refs. [5, 6]).
+"""Multi-robot breadth-first exploration, the BFS baseline of Nagavarapu et al. (refs. [5, 6]).
 
-Seed 003 describes BFS only as "gradually increases the distance from root vertex"; the
+Nagavarapu et al. describes BFS only as "gradually increases the distance from root vertex"; the
 rules below are inferred. Each robot keeps and merges the incidence matrix like the
 proposed method (same beacons, same travel over its known completed graph, same
 re-selection and Theorem 1 completion: :class:`~algorithms.exploration.incidence_dfs.FrontierExplorer`).

@@ -1,6 +1,6 @@
 """Vertex entry: the messages between a robot and the vertex stations.
 
-Seed 003 emulated beacons with a central station over XBee that kept "separate
+Nagavarapu et al. emulated beacons with a central station over XBee that kept "separate
 information for each vertex"; ours also decides who may enter which vertex area (one
 robot per area, :mod:`mjswarm.experiments.stations` explains why no circular wait forms). Robots
 reach the stations from anywhere (the station's XBee link), one control tick each way,

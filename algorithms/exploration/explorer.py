@@ -1,4 +1,4 @@
-"""The embodied explorer: one robot of seed 003 as a :class:`~algorithms.robot.Controller`.
+"""The embodied explorer: one robot of Nagavarapu et al. as a :class:`~algorithms.robot.Controller`.
 
 It composes, fed only by its own observation:
 
@@ -6,10 +6,10 @@ It composes, fed only by its own observation:
   edge discovery by scanning the spokes, odometry) on its line sensors, IR and encoders;
 * an exploration :class:`~algorithms.exploration.Strategy` (the graph world's code),
   called at every vertex arrival with the beacon it stands on and the angles it measured;
-* a :class:`~algorithms.collision.CollisionRule` (seed 003 Sec. 4) setting its speed
+* a :class:`~algorithms.collision.CollisionRule` (Nagavarapu et al. Sec. 4) setting its speed
   from its bearings while it follows a lane;
 * vertex entry (:mod:`algorithms.exploration.entry`) with the stations;
-* optionally a :class:`~algorithms.connectivity.ConnectivityTable` (seed 004) kept over
+* optionally a :class:`~algorithms.connectivity.ConnectivityTable` (Le et al.) kept over
   its radio: its belief whether a single robot's loss would cut it off the reference;
 * optionally a :class:`~algorithms.exploration.tether.Tether` (connected
   exploration), in the graph world's :class:`~algorithms.exploration.relay.ConnectedExplorer`
@@ -36,7 +36,7 @@ It composes, fed only by its own observation:
 
 Choices beyond the paper (the loop functions in :mod:`mjswarm.experiments.exploration` say the rest):
 
-* **The speed rule applies on edges** (following a lane, seed 003 Sec. 4 "traversing an
+* **The speed rule applies on edges** (following a lane, Nagavarapu et al. Sec. 4 "traversing an
   edge"); in the vertex area robots move at S and are kept apart by vertex entry. A robot
   slowed by the rule while leaving a vertex would keep that vertex's area occupied,
   and at the vertex centre the rule's "beta = 0: stop" would stop a robot
@@ -503,7 +503,7 @@ class Explorer(Controller):
         still on its lane for ``CREEP_AFTER_S`` and its front IR sees nothing within
         ``CREEP_GUARD_M``.
 
-        Seed 003's rule stops a robot for one whose bearing stays in its same-lane cone
+        Nagavarapu et al.'s rule stops a robot for one whose bearing stays in its same-lane cone
         and does not change, and resumes when it changes. Bearings carry no range: a robot
         standing on the centre of the vertex beyond the next, waiting for the vertex this
         robot holds, can fall within the cone of a robot whose nose (and so its estimate of

@@ -1,5 +1,5 @@
 """Flooding, the tree exploration of Cabrera-Mora and Xiao (IEEE T-SMC-B 2012; "A flooding
-algorithm for multirobot exploration"), compared in seed 003 section 6 (E + r steps with
+algorithm for multirobot exploration"), compared in Nagavarapu et al. section 6 (E + r steps with
 two robots on a tree).
 
 The paper's abstract: robots are "fed into the tree one at a time", and the number of
@@ -11,7 +11,7 @@ bookkeeping and choices (:mod:`~algorithms.exploration.mr_dfs`):
   enter the tree one per step; that staggering is the only form of the per-step capacity
   restriction modelled here.
 * Robots help in unfinished subtrees as in MR-DFS. A variant in which robots never enter
-  an edge another robot took exceeds seed 003's E + r bound for two robots on trees (by up
+  an edge another robot took exceeds Nagavarapu et al.'s E + r bound for two robots on trees (by up
   to 15 steps on random 5 x 5 grid trees), so it is not what the paper compared with.
 * Cycles (the paper is for trees) are handled as in MR-DFS.
 """

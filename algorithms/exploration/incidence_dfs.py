@@ -1,4 +1,4 @@
-"""Seed 003's decentralised multi-robot exploration: the modified MR-DFS with the
+"""Nagavarapu et al.'s decentralised multi-robot exploration: the modified MR-DFS with the
 incidence matrix (section 3, Algorithms 3 and 4, priority (4), Theorem 1 / Remark 5).
 
 One call of :meth:`FrontierExplorer.on_vertex` is one update instance ``n`` for the

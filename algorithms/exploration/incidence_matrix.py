@@ -1,4 +1,4 @@
-"""Seed 003's modified incidence matrix (section 2, section 3.1, Algorithms 1 and 2).
+"""Nagavarapu et al.'s modified incidence matrix (section 2, section 3.1, Algorithms 1 and 2).
 
 Rows are vertex tags (beacon ids), columns are edges. An entry is ``-theta`` for a
 completed or out edge and ``+theta`` for an unexplored one, ``theta`` in (0, 2*pi] being

@@ -1,5 +1,5 @@
 """Least recently visited (LRV), the baseline of Batalin and Sukhatme (IEEE T-RO 2007) as
-seed 003 compares it on the 10 x 10 lattice (Fig. 17).
+Nagavarapu et al. compares it on the 10 x 10 lattice (Fig. 17).
 
 LRV is a local rule: the node (here the beacon) keeps, for each of its edges, how many
 times robots have traversed it, and a robot leaves along the least traversed one. Rules

@@ -1,5 +1,5 @@
 """MR-DFS, the multi-robot depth-first search of Brass, Cabrera-Mora, Gasparri and Xiao
-(IEEE T-RO 27(4), 2011), the main baseline of seed 003 (section 6, Figs. 8, 16, 17).
+(IEEE T-RO 27(4), 2011), the main baseline of Nagavarapu et al. (section 6, Figs. 8, 16, 17).
 
 Bookkeeping devices at the vertices record, for each edge, how many robots went down it
 and whether it is *finished* (everything behind it explored). A robot at a vertex:
@@ -32,7 +32,7 @@ Rules inferred where the paper's text was not available to us:
   (:mod:`~algorithms.exploration.mapping`); it plays no part in the decisions.
 
 Checks (tests): with one robot this is single-robot DFS, exactly 2E steps on a tree; with
-two robots it takes at most E + r (seed 003 section 6) on random trees.
+two robots it takes at most E + r (Nagavarapu et al. section 6) on random trees.
 """
 
 from __future__ import annotations

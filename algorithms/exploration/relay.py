@@ -153,7 +153,7 @@ class Waits(NamedTuple):
 
 
 class ConnectedExplorer:
-    """A seed-003 strategy on a tether, with relays on demand (module docstring).
+    """An exploration strategy on a tether, with relays on demand (module docstring).
 
     The world calls, each tick: :meth:`hear`; at a vertex :meth:`arrive` (all robots of a
     batch first) and :meth:`on_vertex`; on an edge :meth:`direction` and, for the step,

@@ -1,7 +1,8 @@
 """Exploration that stays connected: the tether every robot keeps to the base.
 
-Seed 003 explores without communication limits; seeds 001, 002 and 004 keep a team
-connected but do not explore. Here each robot explores with its seed-003 strategy while it
+Nagavarapu et al. explore without communication limits; Kobayashi et al., Ahmadi & Stone
+and Le et al. keep a team
+connected but do not explore. Here each robot explores with its exploration strategy (Nagavarapu et al.) while it
 keeps a radio route to the base station at the root. The strategy decides where to go;
 the tether only gates and delays moves. Every rule below is ours (the seeds give none for
 this combination):
@@ -13,12 +14,12 @@ this combination):
    (:func:`docked`). The parent relation is then acyclic, so ordered from the base every
    robot joins the ones before it by two links, and a graph grown from an edge (base and
    first robot) by vertices joined to two earlier ones is biconnected: one robot failing
-   never cuts anyone off (seed 004's two access paths). Rules 2-4 hold for every parent.
+   never cuts anyone off (Le et al.'s two access paths). Rules 2-4 hold for every parent.
    The first robot stands at the root in the graph world; a body cannot (the root's
    area holds one robot, and every launch and every return passes through it), so on
    the MuJoCo robots it stays off the floor, its antenna on the base's mast: the same
    radio node as in the graph world, at the cost of one robot in both.
-2. **Holding** (seed 001's repeater role). A robot with children does not move: it relays.
+2. **Holding** (Kobayashi et al.'s repeater role). A robot with children does not move: it relays.
    Its children are the robots whose last beat named it as parent, and those it adopted
    in the last ``ADOPT_GRACE_TICKS`` ticks (their first beat naming it is on its way).
 3. **Leash.** A robot without children takes a step only if, after the step, its parents
@@ -27,7 +28,7 @@ this combination):
    the reserve as well (0 in the graph world; on bodies the width of a U-turn, which
    sidesteps across the lane and may take a robot at the end of its leash farther). It
    knows where its radio neighbours are relative to itself (a range-and-bearing sensor,
-   as seed 001's robots have) and what its own step will be. Parents hold and the base
+   as Kobayashi et al.'s robots have) and what its own step will be. Parents hold and the base
    never moves, so every tree link survives every tick, and nobody is ever cut off from
    the base.
 4. **Adoption, make before break.** A robot without children whose step the leash forbids

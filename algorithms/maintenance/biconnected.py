@@ -1,4 +1,4 @@
-"""Ahmadi & Stone (seed 002): adding and removing robots while the team stays biconnected.
+"""Ahmadi & Stone: adding and removing robots while the team stays biconnected.
 
 Each robot is responsible for a circular region and holds at its centre. Two robots are
 neighbours when their centres are at most ``link_m`` apart (the experiment runner derives
@@ -190,7 +190,7 @@ def least_d(ex_neighbours: Mapping[Hashable, Point], pos: Point, params: Params)
 
 
 class BiconnectedRobot(Controller):
-    """One robot of seed 002's maintenance: holds its region, joins, leads after a removal.
+    """One robot of Ahmadi & Stone's maintenance: holds its region, joins, leads after a removal.
 
     As a :class:`~algorithms.robot.Controller` (:meth:`step`) it reads its positioning
     sensor and radio and answers with a planar velocity and its messages; its clock is

@@ -1,4 +1,4 @@
-"""The Acute Angle Test and Algorithm 2 of Kobayashi, Higuchi & Ueno (seed 001, Sect. III-D).
+"""The Acute Angle Test and Algorithm 2 of Kobayashi, Higuchi & Ueno (Sect. III-D).
 
 A robot ``r_i`` connects to ``r_j`` iff the angle ``x_i x_k x_j`` is acute for every other
 robot ``r_k`` it detects: no robot lies in the circle ``C_ij`` with diameter ``x_i x_j``.

@@ -1,4 +1,4 @@
-"""Circular regions on the plane (seed 002's experiment): union area, candidate centres,
+"""Circular regions on the plane (Ahmadi & Stone's experiment): union area, candidate centres,
 moving towards a point, and the Theorem 1 biconnectivity test on a small graph.
 
 All lengths in metres, areas in square metres. Pure numpy.
@@ -76,7 +76,7 @@ def _uncovered_arcs(covered: list[tuple[float, float]]) -> list[tuple[float, flo
 def move_towards(point: Sequence[float], target: Sequence[float], d: float) -> Point:
     """``point`` moved ``d`` metres straight towards ``target``, stopping at ``target``.
 
-    Seed 002's MOVE(pos, d). Stopping at ``pos`` is our choice (the paper does not say what
+    Ahmadi & Stone's MOVE(pos, d). Stopping at ``pos`` is our choice (the paper does not say what
     a robot closer than d does). The map is the proximal operator of ``d * |p - pos|``, so
     it never increases the distance between two points: no link is lost by a MOVE, the
     property the paper's removal argument rests on.
@@ -175,7 +175,7 @@ def candidate_centres(centres: Sequence[Sequence[float]], link_m: float,
 
     The candidates lie on the circles of radius ``link_m`` around the known centres (a
     sum of distances is largest on that boundary): ``samples`` points per circle and the
-    pairwise intersection points of the circles (the exact optimum of seed 002's
+    pairwise intersection points of the circles (the exact optimum of Ahmadi & Stone's
     criterion for two neighbours). A discretisation: the paper does not say how the new
     robot searches the plane. With no centres the only candidate is none (empty list).
     """
@@ -204,7 +204,7 @@ def _circle_intersections(a: Point, b: Point, r: float) -> list[Point]:
 
 
 def two_closest_sum(p: Sequence[float], centres: Sequence[Sequence[float]]) -> float:
-    """Seed 002's placement criterion: the sum of the distances from ``p`` to the two
+    """Ahmadi & Stone's placement criterion: the sum of the distances from ``p`` to the two
     closest region centres (to the one centre when there is only one), metres."""
     return float(sum(sorted(math.dist(p, c) for c in centres)[:2]))
 

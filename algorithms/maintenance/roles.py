@@ -1,4 +1,4 @@
-"""Role switching for continuous connectivity (Kobayashi, Higuchi & Ueno, seed 001).
+"""Role switching for continuous connectivity (Kobayashi, Higuchi & Ueno, Kobayashi et al.).
 
 Each robot is a :class:`RoleSwitchingRobot` that sees only its own position, the robots it
 detects within d_s (:class:`Detected`: position and role) and its inbox, and returns its
@@ -85,7 +85,7 @@ FLOCK = (Role.LOCAL_LEADER, Role.EXPLORER)
 
 @dataclass(frozen=True)
 class RoleParams:
-    """Parameters of seed 001 in metres and steps (1 paper unit = 1 m).
+    """Parameters of Kobayashi et al. in metres and steps (1 paper unit = 1 m).
 
     ``d_c``, ``d_s`` = 3 and ``eta_c`` = 3 are the paper's (Sect. IV-A); ``v_max`` is its
     0.03 unit/step cap. The rest are ours: margins ``eta_a``, ``eta_b`` of Algorithm 1,
@@ -196,7 +196,7 @@ def _unit(v: np.ndarray) -> np.ndarray:
 
 
 class RoleSwitchingRobot(Controller):
-    """One robot's controller for seed 001.
+    """One robot's controller for Kobayashi et al..
 
     As a :class:`~algorithms.robot.Controller` (:meth:`step`) it reads its position from
     its positioning sensor, the robots within d_s from its range-and-bearing sensor (the

@@ -1,4 +1,4 @@
-"""Sensor-only navigation on line-marked arenas (seed 003, Sec. 5).
+"""Sensor-only navigation on line-marked arenas (Nagavarapu et al., Sec. 5).
 
 Pure Python: the embodied adapter (:mod:`mjswarm.experiments.exploration`) feeds each robot's own
 readings (line sensors, IR, wheel encoders) in, and applies the ``(v, omega)`` that comes

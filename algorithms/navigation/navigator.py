@@ -1,4 +1,4 @@
-"""A robot's way around a line-marked arena, from its own sensors only (seed 003, Sec. 5).
+"""A robot's way around a line-marked arena, from its own sensors only (Nagavarapu et al., Sec. 5).
 
 The arena conventions (the marks a robot is built to read, not the graph): every edge has
 two lane strips ``lane_offset_m`` either side of its centre line, and a robot drives on
@@ -42,7 +42,7 @@ Behaviours, chained as plans of :mod:`~algorithms.navigation.motions`:
 * **leaving**: sidestep from the vertex centre to the left of the chosen spoke by
   ``lane_offset_m`` and find the lane ahead. (Not along the spoke first: two robots
   leaving the two ends of one edge at once would then face each other on its centre line,
-  where the collision rule stops both, seed 003 eq. (27) with ``beta = 0``.)
+  where the collision rule stops both, Nagavarapu et al. eq. (27) with ``beta = 0``.)
 
 Choices: the approach and departure shifts are open-loop odometry manoeuvres at 60
 degrees; the vertex-centre estimate has the accuracy of line following plus a 8 cm
@@ -371,7 +371,7 @@ class Navigator:
         into its lane's frame: ``beta + theta - lane direction``, the lane's direction
         estimated in the odometry frame from the ticks aligned with it so far
         (:meth:`~.motions.FollowLine.direction`, all of the lane). The speed rule's
-        ``beta = 0`` is "ahead on the same lane" (seed 003 eq. (27)); a line follower's
+        ``beta = 0`` is "ahead on the same lane" (Nagavarapu et al. eq. (27)); a line follower's
         nose swings a few degrees about its lane (more when its line filter lags),
         and a robot standing on the centre of the vertex beyond the next one, 5-13 degrees
         off the lane within the sensor's metre, came within the rule's 2.6 degree cone of

@@ -5,7 +5,7 @@ builder and the robots' navigation. All lengths are metres, all angles radians u
 a name ends in ``_DEG``. The world is the x-y plane, +z up; an edge ``(u, v)`` has the
 direction ``u -> v``, and "left" means counter-clockwise of that direction seen from +z.
 
-Layout of one edge (seed 003, Sec. 4 and Fig. 3: two lanes per edge, a robot keeps
+Layout of one edge (Nagavarapu et al., Sec. 4 and Fig. 3: two lanes per edge, a robot keeps
 to one side; Sec. 5: black strips on the floor, walls along the free paths so the IR
 sensors see an obstacle on an edge and none at a vertex):
 
@@ -136,7 +136,7 @@ class Spoke:
 def incidence_angle(spec: ArenaSpec, u: str, v: str) -> float:
     """Angle of edge ``u -> v`` measured at ``u`` from +x, counter-clockwise, in [0, 2 pi).
 
-    This is the paper's incidence angle (seed 003, Sec. 3, entries of I(vj)), here in
+    This is the paper's incidence angle (Nagavarapu et al., Sec. 3, entries of I(vj)), here in
     [0, 2 pi) as the brief asks. Raises ``KeyError`` if ``u``-``v`` is not an edge.
     """
     if (u, v) not in spec.edges and (v, u) not in spec.edges:

@@ -13,7 +13,7 @@ File format (JSON or TOML), all keys required except ``description``::
 
 Vertex ids are letters, digits and ``_`` (they become MuJoCo names). Unknown keys are
 rejected so that typos do not pass silently. Edge order and orientation are kept as
-given (seed 003 numbers edges e1, e2, ... in the order listed).
+given (Nagavarapu et al. numbers edges e1, e2, ... in the order listed).
 """
 
 from __future__ import annotations

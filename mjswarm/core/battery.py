@@ -5,7 +5,7 @@ The Spark V runs on a 9.6 V NiMH pack (8 cells). We model, per robot:
 * current draw ``I = I_idle + sum_wheels |tau| / k_t``: ``tau`` is the actuator torque
   (N m) MuJoCo applies at the wheel and ``k_t`` the torque per ampere at the wheel
   (gearbox included), chosen so that the actuator's torque limit (0.12 N m) draws the
-  600 mA the L293D driver supplies per motor (seed 003, Sec. 5);
+  600 mA the L293D driver supplies per motor (Nagavarapu et al., Sec. 5);
 * charge used ``Q += I dt`` (A s);
 * open-circuit voltage falling linearly from ``v_full`` to ``v_empty`` as ``Q`` reaches
   the capacity, and terminal voltage ``V = V_oc - R_internal * I``.

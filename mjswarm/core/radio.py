@@ -1,7 +1,7 @@
 """The robots' radio: one-hop broadcast within range d_c, delivered one control tick later.
 
-This is the communication model both connectivity papers assume (seed 002, Assumptions 2
-and 4; seed 004, section 2): identical ranges (so links are symmetric), a message sent by a
+This is the communication model both connectivity papers assume (Ahmadi & Stone, Assumptions 2
+and 4; Le et al., section 2): identical ranges (so links are symmetric), a message sent by a
 robot is heard by every robot within range d_c of it, and it arrives within one period c,
 which here is exactly one control tick. On top of that the radio can drop each copy of a
 message with probability ``drop_prob`` (seeded numpy Generator) and can block a link when
@@ -533,7 +533,7 @@ class Radio:
 
 class Uplink:
     """The link between the robots and one piece of infrastructure at ``address`` (the
-    vertex stations: seed 003's central station over XBee): every robot reaches it from
+    vertex stations: Nagavarapu et al.'s central station over XBee): every robot reaches it from
     anywhere, one control tick each way, no drops; counted both ways.
 
     Robots send with ``Message(payload, to=address)``; the world hands those to

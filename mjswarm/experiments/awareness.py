@@ -5,7 +5,7 @@ robots' beliefs are checked against (the radio's line of sight is
 With ``--radio-range R`` an embodied run gives every robot a radio (:class:`mjswarm.core.radio.
 Radio`: range ``R``, one control tick of latency, links blocked by walls through
 :attr:`mjswarm.core.simulation.Simulation.sight`, vectorised over pairs) and a connectivity
-table of internally disjoint access paths to the reference robot R1 (seed 004,
+table of internally disjoint access paths to the reference robot R1 (Le et al.,
 :class:`algorithms.connectivity.tables.ConnectivityTable`, kept by each
 :class:`~algorithms.exploration.explorer.Explorer`). Each robot's *belief* is its table's
 answer to "does any single robot's loss cut me off the reference?": ``biconnected`` when

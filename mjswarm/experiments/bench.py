@@ -9,7 +9,7 @@ robots in a grid, each on its own floor strip, walls beside every row) and measu
   :class:`~mjswarm.worlds.sparkworld.SparkWorld`, run by the one :class:`~mjswarm.worlds.loop.Loop`): every robot's line, IR, encoder and wheel-speed readings, its
   bearing sensor (+-60 degrees, 1 m, line of sight), a radio (range ``RADIO_RANGE_M``,
   links need line of sight both ways) on which every robot broadcasts a heartbeat every
-  tick and reads its inbox, and per robot the seed-003 speed rule
+  tick and reads its inbox, and per robot Nagavarapu et al.'s speed rule
   (:class:`~algorithms.batch_collision.BatchCollisionRule` over pair arrays, or
   :class:`~algorithms.collision.CollisionRule` per robot; bearing rates) setting the speed of a
   line follower that steers from the robot's own line sensors;

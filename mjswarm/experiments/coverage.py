@@ -1,4 +1,4 @@
-"""Seed 002's experiment: S-coverage of a biconnected team under random additions and
+"""Ahmadi & Stone's experiment: S-coverage of a biconnected team under random additions and
 removals (Ahmadi & Stone, "Experimental Results").
 
 Setting: every robot is responsible for a circular region of one size; at most

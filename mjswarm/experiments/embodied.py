@@ -40,7 +40,7 @@ class EmbodiedConfig:
     """Parameters of an embodied run (SI units).
 
     Attributes:
-        speed_m_s: the initial speed S of every robot (seed 003's experiments: 0.05).
+        speed_m_s: the initial speed S of every robot (Nagavarapu et al.'s experiments: 0.05).
         collision_avoidance: the speed rule and vertex entry (see module doc).
         epsilons: per-robot eps_k (eq. 28); default :func:`algorithms.collision.epsilons`.
         launch_interval_s: least time between two launches from the root.

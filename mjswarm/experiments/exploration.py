@@ -21,7 +21,7 @@ A recording is a loop function the caller hands in. One tick::
 
 Choices it makes, beyond the paper:
 
-* **Beacons** are a store keyed by the arena's vertex (seed 003 emulated beacons with a
+* **Beacons** are a store keyed by the arena's vertex (Nagavarapu et al. emulated beacons with a
   central station over XBee, "separate information for each vertex"; so do we). A robot
   gets the beacon in its observation only while it stands on the vertex centre (within
   ``ON_VERTEX_M``; the station knows who stands on its centre, as the paper's station
@@ -47,7 +47,7 @@ Choices it makes, beyond the paper:
   heading 0 along the world's +x, the common reference direction of the incidence angles.
 * **Connectivity awareness** (``radio_range_m``): robots carry radios (range R, one tick of
   latency, links blocked by walls) and each keeps a connectivity table of internally
-  disjoint access paths to R1 (seed 004). Its *belief* is ``biconnected`` when it has
+  disjoint access paths to R1 (Le et al.). Its *belief* is ``biconnected`` when it has
   two such paths; the *truth* (:func:`mjswarm.experiments.awareness.truth`) is whether it shares a
   biconnected component of three or more with R1 in the radio graph; both are sampled
   five times a second into ``radio_belief_agreement``. Robots in the depot or failed
@@ -68,7 +68,7 @@ Choices it makes, beyond the paper:
   The robots' own stall verdict (rule 5) replaces the ``stall_timeout_s`` check.
   Tables (connectivity awareness) are off in these runs.
 * **Metrics**: ``makespan`` is the largest number of edges any robot had traversed when
-  completion was declared (the synchronous world's step count; seed 003 counts "edge
+  completion was declared (the synchronous world's step count; Nagavarapu et al. counts "edge
   traversals"), ``total_traversals`` the sum; ``collisions`` are robot-robot contact events
   (ground truth, never seen by robots); ``speed_changes`` the collision rule's activations
   (eq. 27); ``heading_error_deg`` the largest odometry heading error of any robot, on

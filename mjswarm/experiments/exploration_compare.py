@@ -1,4 +1,4 @@
-"""Seed 003's exploration comparisons (section 6), rerun in the graph world.
+"""Nagavarapu et al.'s exploration comparisons (section 6), rerun in the graph world.
 
 * Fig. 8: the four 12-edge trees ``tree1``..``tree4``, K = 2..10, proposed vs MR-DFS.
 * Fig. 17: the 10 x 10 lattice (100 vertices, 180 edges), K = 1..20, proposed vs BFS, LRV
@@ -109,7 +109,7 @@ def run_comparison(quick: bool = False, seeds: int = 10, progress: bool = True) 
 def markdown(rows: list[Row], seeds: int) -> str:
     """Tables, one per figure: each cell is ``canonical (worst)`` makespan in steps."""
     lines = [
-        "# Seed 003 exploration comparisons (graph world, unit edge time)",
+        "# Nagavarapu et al. exploration comparisons (graph world, unit edge time)",
         "",
         "Cells: makespan in steps with the fixed tie rules, and in parentheses the worst "
         + f"over those and {seeds} seeded random tie-breakings. '-' marks a failed run.",
@@ -160,14 +160,14 @@ def plot(rows: list[Row], out_dir: Path) -> list[Path]:
             ax.axhline(panel[0].edges, color="grey", lw=0.8, ls=":", label="E")
             ax.set_title(tree)
         axes.flat[0].legend(fontsize=8)
-        fig.suptitle("Seed 003 Fig. 8: edge traversals to complete, trees with 12 edges")
+        fig.suptitle("Nagavarapu et al. Fig. 8: edge traversals to complete, trees with 12 edges")
         written.append(_save(fig, out_dir / "fig8.png"))
     panel = [r for r in rows if r.figure == "fig17"]
     if panel:
         fig, ax = plt.subplots(figsize=(7, 5))
         _lines(ax, panel)
         ax.legend(fontsize=8)
-        ax.set_title("Seed 003 Fig. 17: 10 x 10 lattice")
+        ax.set_title("Nagavarapu et al. Fig. 17: 10 x 10 lattice")
         written.append(_save(fig, out_dir / "fig17.png"))
     return written
 

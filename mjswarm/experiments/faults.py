@@ -5,7 +5,7 @@ Forms (times in simulated seconds; robots numbered from 1, as in every output):
 ``robot:I@T``
     Robot I fails at T: it stops where it is and stays there as an obstacle, its radio
     goes silent, and it releases every vertex it holds (:mod:`mjswarm.experiments.stations`). The
-    edge it had selected stays *out* in the beacons it marked; seed 003's priority (4)
+    edge it had selected stays *out* in the beacons it marked; Nagavarapu et al.'s priority (4)
     keeps out edges as the last candidates (``Eo``), so another robot takes it once the
     unexplored edges run out: a dead robot's claim never needs to expire for the
     exploration to finish. A body left in a vertex area closes that vertex

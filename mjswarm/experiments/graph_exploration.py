@@ -4,7 +4,7 @@
 (ground truth: where each robot goes, where each beacon was dropped) and the robots'
 reports (:class:`~algorithms.exploration.events.Declared`), stops the run when a robot
 declares completion, when no robot will be called again, or after ``max_time`` time
-units, and gives seed 003's metrics (:class:`~mjswarm.experiments.results.
+units, and gives Nagavarapu et al.'s metrics (:class:`~mjswarm.experiments.results.
 ExplorationResult`). Robots are :func:`~algorithms.exploration.graph_explorer.
 graph_explorer` controllers around their strategies, or any controller a user writes
 against :class:`~algorithms.robot.Observation` and :class:`~algorithms.robot.Command`.
@@ -35,7 +35,7 @@ def default_max_time(world: GraphWorld) -> float:
 
 
 class GraphExploration(LoopFunctions):
-    """Seed 003's metrics of one graph-world run (module docstring)."""
+    """Nagavarapu et al.'s metrics of one graph-world run (module docstring)."""
 
     def __init__(self, world: GraphWorld, strategy: str, *, seed: int | None = None,
                  max_time: float | None = None, arena: str = "<graph>") -> None:

@@ -1,7 +1,7 @@
 """Launching robots from the root, one at a time (a loop function of embodied exploration).
 
 Robots wait in a depot outside the arena and are put on the root centre one at a time
-(as seed 003's robots were placed by hand), in ``order``, at least ``interval_s`` apart,
+(as Nagavarapu et al.'s robots were placed by hand), in ``order``, at least ``interval_s`` apart,
 whenever the root is free: no launched robot that is still at work stands within
 ``ROOT_CLEAR_M`` of it, and (with vertex entry) no robot holds it. Each starts with
 compass heading 0 along the world's +x, the common reference direction of the

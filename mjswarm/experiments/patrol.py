@@ -1,4 +1,4 @@
-"""The patrol mission of Kobayashi, Higuchi & Ueno (seed 001, Sect. IV-B) on our robots.
+"""The patrol mission of Kobayashi, Higuchi & Ueno (Sect. IV-B) on our robots.
 
 Robot 0 is the base station at the origin; robots 1..N-1 start at random in the fan
 ``||x|| <= 0.6 sqrt(N)`` m, x, y >= 0 (the quadrant of the targets), at least 0.2 m
@@ -53,7 +53,7 @@ from mjswarm.core.radio import Radio
 
 #: Duration of one paper timestep (s): 0.03 m/step = 0.2 m/s, 0.15 rad/step = 1 rad/s.
 STEP_S = 0.15
-#: Seed 001's turn-rate cap, 0.15 rad per timestep (Sect. III-C).
+#: Kobayashi et al.'s turn-rate cap, 0.15 rad per timestep (Sect. III-C).
 PAPER_TURN_CAP_RAD_PER_STEP = 0.15
 WORLDS = ("embodied", "point")
 

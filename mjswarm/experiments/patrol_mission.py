@@ -1,4 +1,4 @@
-"""The patrol mission's loop functions (Kobayashi, Higuchi & Ueno, seed 001, Sect. IV-B):
+"""The patrol mission's loop functions (Kobayashi, Higuchi & Ueno, Kobayashi et al., Sect. IV-B):
 the experimenter's targets for the base station, and the mission's measurements.
 
 The experimenter never reads or writes a controller's attributes. Targets reach the base

@@ -1,4 +1,4 @@
-"""Seed 003 exploration under a connectivity constraint, in the graph world with a radio
+"""Nagavarapu et al. exploration under a connectivity constraint, in the graph world with a radio
 (:class:`~mjswarm.worlds.radiograph.RadioGraphWorld`), on the one loop.
 
 Robots are :class:`~algorithms.exploration.graph_explorer.TetheredExplorer` controllers;
@@ -9,7 +9,7 @@ rule 5's verdict and the ground truth of the radio graph.
 
 ``connectivity``:
 
-* ``"none"``: seed 003 unchanged (robots never wait; no messages).
+* ``"none"``: Nagavarapu et al. unchanged (robots never wait; no messages).
 * ``"connected"`` / ``"biconnected"``: each robot keeps its tether of one / two parents
   (:mod:`algorithms.exploration.tether`; with ``biconnected`` robot 0 docks at the base,
   rule 1, and explores nothing) and
@@ -17,7 +17,7 @@ rule 5's verdict and the ground truth of the radio graph.
   edges both ways and may stop part-way.
 
 One tick (the world's two phases, :mod:`mjswarm.worlds.radiograph`), for every robot in
-descending index (the order of seed 003's Fig. 9 run):
+descending index (the order of Nagavarapu et al.'s Fig. 9 run):
 
 1. move phase: every robot and the base read the messages delivered at the last tick's
    end; robots at a vertex whose time has come (they reached it in the last tick, or

@@ -1,6 +1,6 @@
-"""What an exploration run measures, in every world: seed 003's metrics.
+"""What an exploration run measures, in every world: Nagavarapu et al.'s metrics.
 
-``makespan`` is the time of the declaration (seed 003's "number of edge traversals" to
+``makespan`` is the time of the declaration (Nagavarapu et al.'s "number of edge traversals" to
 complete; embodied runs count the edges of the busiest robot instead);
 ``total_traversals`` and ``traversals_per_robot`` count the edge traversals finished by
 then; ``map_edges`` is the declaring robot's map translated from beacon ids to arena
@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass
 
 @dataclass
 class ExplorationResult:
-    """One run's measurements (robots numbered from 1 as R1, R2, ... in seed 003)."""
+    """One run's measurements (robots numbered from 1 as R1, R2, ... in Nagavarapu et al.)."""
 
     arena: str
     strategy: str

@@ -1,6 +1,6 @@
 """Vertex stations: who may enter which vertex area (embodied exploration's vertex entry).
 
-Seed 003's robots kept apart on edges with the bearing-rate rule and spent only a moment
+Nagavarapu et al.'s robots kept apart on edges with the bearing-rate rule and spent only a moment
 at a vertex; ours scan there for about ten seconds, and a robot's sidesteps between the
 vertex centre and its lane cross the lanes of the other edges at that vertex. So a vertex
 area holds one robot at a time, and each vertex has a *station* (the paper's central

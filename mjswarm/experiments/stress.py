@@ -43,16 +43,16 @@ from mjswarm.experiments.faults import parse_fault
 
 #: A fan whose vertex v1 has edges 67.5 degrees apart: a robot arriving at v1 must not be
 #: carried out along a neighbouring spoke.
-ISSUE_13_FAN = {
-    "name": "issue13-fan", "root": "v0",
+NARROW_FAN = {
+    "name": "narrow-fan", "root": "v0",
     "vertices": {"v1": [0, 0], "v0": [0.3515, 0.8485], "v2": [-0.8485, -0.3515],
                  "c": [-0.6494, 0.6494]},
     "edges": [["v0", "v1"], ["v1", "v2"], ["v1", "c"]],
 }
 
-#: Arenas of the grid (names as ``--arena`` takes them); ``issue13-fan`` is the dict above.
+#: Arenas of the grid (names as ``--arena`` takes them); ``narrow-fan`` is the dict above.
 ARENAS = (
-    "issue13-fan", "fan:3:45@17", "wheel:4@8", "wheel:8", "hex:2x2@30", "tri:2x3@7",
+    "narrow-fan", "fan:3:45@17", "wheel:4@8", "wheel:8", "hex:2x2@30", "tri:2x3@7",
     "lattice:4x4@33", "fig9@20", "random-planar:8:1", "random-planar:12:2",
 )
 SPEEDS_M_S = (0.05, 0.1, 0.15, 0.2)
@@ -134,8 +134,8 @@ class StressRun:
     fault: str = ""
 
     def spec(self) -> ArenaSpec:
-        if self.arena == ISSUE_13_FAN["name"]:
-            return parse_arena_spec(ISSUE_13_FAN, "issue 13")
+        if self.arena == NARROW_FAN["name"]:
+            return parse_arena_spec(NARROW_FAN, "the stress grid")
         return load_arena(self.arena)
 
     def run(self, max_sim_time_s: float = 3600.0) -> EmbodiedResult:

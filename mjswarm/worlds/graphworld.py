@@ -1,4 +1,4 @@
-"""The fast, abstract graph world of seed 003's simulations: no physics, beacons at
+"""The fast, abstract graph world of Nagavarapu et al.'s simulations: no physics, beacons at
 vertices, K robots starting at the root, synchronous discrete time; a
 :class:`~mjswarm.worlds.loop.World` of the one loop.
 

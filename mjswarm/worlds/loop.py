@@ -37,7 +37,7 @@ beacon is the exception by design: it is the vertex's store, and robots that sta
 one vertex in one tick read and write it one after another, in the order they step.
 
 Messages sent in a tick are delivered at the end of that tick's ``world.step()`` and read
-in the next tick's observations: the radio's one tick of latency (seed 002 Assumption 4).
+in the next tick's observations: the radio's one tick of latency (Ahmadi & Stone Assumption 4).
 """
 
 from __future__ import annotations

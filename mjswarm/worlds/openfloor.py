@@ -1,4 +1,5 @@
-"""Open-floor worlds for the connectivity-maintenance experiments (seeds 001 and 002).
+"""Open-floor worlds for the connectivity-maintenance experiments 
+(Kobayashi et al.; Ahmadi & Stone).
 
 Two :class:`~mjswarm.worlds.loop.World` s with one implementation, :class:`MotionWorld`, so the
 same controllers run on MuJoCo robots (:class:`EmbodiedFloor`) and on kinematic points
@@ -11,11 +12,11 @@ same controllers run on MuJoCo robots (:class:`EmbodiedFloor`) and on kinematic 
   papers assume robots know their positions; think UWB or motion capture) with optional
   Gaussian noise (``Observation.pose``);
 * with ``detection_range_m``, a **range-and-bearing sensor** reports every present robot
-  within that range (seed 001: "the robots can identify other robots in range d_s"):
+  within that range (Kobayashi et al.: "the robots can identify other robots in range d_s"):
   exact range (m) and bearing (rad, in the observer's frame) from the true poses, and the
-  signal that robot last showed (``Command.signal``; seed 001's robots tell roles apart,
+  signal that robot last showed (``Command.signal``; Kobayashi et al.'s robots tell roles apart,
   our choice is that each shows its role, as an LED colour would);
-* robots can be **added and removed** (seed 002's episodes): an absent robot waits in a
+* robots can be **added and removed** (Ahmadi & Stone's episodes): an absent robot waits in a
   depot outside the floor (embodied) and is invisible to the radio and the sensors.
 
 Ground truth (:meth:`MotionWorld.true_positions`) is for loop functions, metrics and tests.

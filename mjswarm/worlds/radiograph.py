@@ -1,4 +1,4 @@
-"""The graph world with a radio: seed 003's graph, with positions, time in ticks, a base
+"""The graph world with a radio: Nagavarapu et al.'s graph, with positions, time in ticks, a base
 at the root and a radio; a :class:`~mjswarm.worlds.loop.World` of the one loop.
 
 Time runs in ticks of ``1 / TICKS_PER_UNIT`` time units. A robot crosses an edge in its
@@ -20,10 +20,10 @@ A tick has two phases, and the loop steps each as one loop tick:
    (< 0) or stay (0). The steps are taken together: what a robot senses does not depend
    on who acted before it in the tick (the beacon of a vertex aside, by design);
 2. **answer**: every robot senses its neighbours from the new places and may speak
-   (seed 003's tether asks for adoption and beats after a move); the fixed nodes (the
+   (Nagavarapu et al.'s tether asks for adoption and beats after a move); the fixed nodes (the
    base, a robot docked at it) do not step. At the end the radio delivers.
 
-Messages go on the air in the order of seed 003's Fig. 9 run: in each phase the robots'
+Messages go on the air in the order of Nagavarapu et al.'s Fig. 9 run: in each phase the robots'
 (in descending index, the order they step in), then the base's and the docked robot's.
 
 The base stands at the root as the fixed node ``BASE``; with ``dock``, robot 0 is docked
@@ -112,7 +112,7 @@ class RadioGraphWorld(World):
         return self.tick / TICKS_PER_UNIT
 
     def active(self) -> list[int]:
-        """The robots on the floor, in descending index (seed 003's order)."""
+        """The robots on the floor, in descending index (Nagavarapu et al.'s order)."""
         return self._order
 
     @property

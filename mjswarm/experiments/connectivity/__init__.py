@@ -1,5 +1,5 @@
 """Connectivity awareness on a static team: input files, the message-passing harness and
-the message-count comparison (seeds 002 and 004). The per-robot algorithms live in
+the message-count comparison (Ahmadi & Stone and Le et al.). The per-robot algorithms live in
 :mod:`algorithms.connectivity`; the radio in :mod:`mjswarm.core.radio`.
 """
 

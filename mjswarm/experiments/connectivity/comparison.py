@@ -1,7 +1,7 @@
-"""Messages against team size for the three methods (seed 002 vs seed 004).
+"""Messages against team size for the three methods (Ahmadi & Stone vs Le et al.).
 
-The papers' claims: the stamped-message check of seed 002 costs up to (n - 1)! messages
-per robot; seed 004's tables cost O(n^2) messages ("O(4n^2)" with the check) and the
+The papers' claims: the stamped-message check of Ahmadi & Stone costs up to (n - 1)! messages
+per robot; Le et al.'s tables cost O(n^2) messages ("O(4n^2)" with the check) and the
 forward-two variant O(n) ("O(2n)"). We measure messages to the decision on two families:
 
 * ``geometric``: n robots uniform in a 1 m x 1 m square, range chosen for a mean degree

@@ -4,8 +4,8 @@ Each tick every robot (in team order) reads its inbox, sees its neighbours and a
 with messages to send, which the radio delivers at the end of the tick; one tick is the
 papers' c. The robots are :class:`~algorithms.connectivity.participant.Participant`
 controllers in a :class:`~mjswarm.worlds.static.StaticWorld`, run by the one :class:`~mjswarm.worlds.loop.Loop`. The harness counts messages from the radio's counters and stops at the deciding robot's
-decision: the initiator (``stamps``, seed 002 Algorithm 3: tick 6N + 2 at the latest) or
-the reference (``tables`` / ``tables-2``, seed 004 with the gathering of
+decision: the initiator (``stamps``, Ahmadi & Stone Algorithm 3: tick 6N + 2 at the latest) or
+the reference (``tables`` / ``tables-2``, Le et al. with the gathering of
 :class:`algorithms.connectivity.TableCheck`: tick 2N - 1).
 
 The stamps method floods every simple path, so its cost is factorial on dense graphs.
@@ -27,7 +27,7 @@ from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.static import StaticWorld
 from mjswarm.core.radio import Radio
 
-#: Method names: seed 002's stamps, seed 004's tables and its forward-two variant.
+#: Method names: Ahmadi & Stone's stamps, Le et al.'s tables and its forward-two variant.
 METHODS: tuple[str, ...] = ("stamps", "tables", "tables-2")
 #: Default limit on messages (transmissions) before a run is stopped as capped.
 DEFAULT_MESSAGE_CAP = 200_000
@@ -102,8 +102,8 @@ def drive(
 
 
 def _checkers(method: str, ids: tuple, leader, max_robots: int | None) -> dict:
-    """Every robot's mind for ``method``: the stamps check of seed 002 or the
-    connectivity tables of seed 004 (forwarding two tables with ``tables-2``)."""
+    """Every robot's mind for ``method``: the stamps check of Ahmadi & Stone or the
+    connectivity tables of Le et al. (forwarding two tables with ``tables-2``)."""
     n = len(ids)
     if method == "stamps":
         return {r: BiconnectivityCheck(r, n, max_robots=max_robots, initiator=r == leader)
@@ -132,7 +132,7 @@ def run_check(
         range_m: radio range d_c in metres (required unless the team has explicit edges).
         initiator: the robot that starts the check (stamps) or is the reference (tables);
             default the team's first robot.
-        max_robots: N of seed 002 Assumption 1 (default n); sets the timing.
+        max_robots: N of Ahmadi & Stone Assumption 1 (default n); sets the timing.
         drop_prob, seed: radio message loss (the papers assume none).
         message_cap: stop once more messages than this were sent (None: no cap).
     """
