@@ -123,7 +123,7 @@ def embodied() -> str:
 
     rows = []
     for arena, (k, paper) in EMBODIED_PAPER.items():
-        r = run_exploration(load_arena(arena), k, world="embodied", seed=0)
+        r = run_exploration(load_arena(arena), k, world="embodied")
         rows.append([f"`{arena}`", k, paper, r.makespan, r.total_traversals,
                      "yes" if r.map_correct else "no", r.collisions,
                      f"{r.sim_time_s:.0f}"])

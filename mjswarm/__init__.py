@@ -39,4 +39,4 @@ if GL_PROBLEM:
     os.environ["MUJOCO_GL"] = "disable"
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"

@@ -86,3 +86,17 @@ def test_every_measured_table_names_its_command():
     assert tables
     for table in tables:
         assert "*Measured by `python benchmarks/" in table.read_text(), table.name
+
+
+def test_the_version_follows_the_changelog():
+    try:
+        import tomllib
+    except ImportError:  # Python 3.10
+        import tomli as tomllib
+
+    from mjswarm import __version__
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    released = re.findall(r"^## \[(\d+\.\d+\.\d+)\]", (ROOT / "CHANGELOG.md").read_text(),
+                          re.MULTILINE)
+    assert project == __version__ == released[0]
