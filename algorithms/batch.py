@@ -40,9 +40,10 @@ class Readings(NamedTuple):
         encoder_rad: wheel encoders (left, right), rad, shape (K, 2).
         wheel_speed_rad_s: wheel speeds (left, right), rad/s, shape (K, 2).
         battery_v: battery voltage, V, shape (K,).
-        bearing_row, bearing_id, bearing_rad: the bearing sensor's pairs, shape (P,): the
-            observing row, the id it reports and the bearing (rad, robot frame), sorted by
+        bearing_row: the bearing sensor's pairs, shape (P,): the observing row, sorted by
             row, then id.
+        bearing_id: the id the sensor reports for each pair, shape (P,).
+        bearing_rad: the bearing of each pair (rad, robot frame), shape (P,).
         inbox: the messages received this tick, each once; ``inbox_copy`` (C,) indexes
             them, row by row in delivery order, row ``r``'s copies being
             ``inbox_copy[inbox_bounds[r]:inbox_bounds[r + 1]]`` (``inbox_bounds``: (K + 1,)).
@@ -104,8 +105,8 @@ class BatchCommand(NamedTuple):
     :class:`Readings`.
 
     Attributes:
-        v_m_s, omega_rad_s: unicycle commands, forward speed (m/s) and turn rate (rad/s),
-            shape (K,).
+        v_m_s: unicycle commands' forward speeds (m/s), shape (K,).
+        omega_rad_s: unicycle commands' turn rates (rad/s), shape (K,).
         broadcast: the rows that broadcast ``payload`` this tick (one-hop, one
             transmission each), bool shape (K,), or None for none.
         payload: what they broadcast (an immutable value).

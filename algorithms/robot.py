@@ -136,7 +136,8 @@ class Command(NamedTuple):
     """What one robot does in one control tick.
 
     Attributes:
-        v_m_s, omega_rad_s: unicycle command, forward speed (m/s) and turn rate (rad/s).
+        v_m_s: unicycle command, forward speed (m/s).
+        omega_rad_s: unicycle command, turn rate (rad/s).
         velocity_m_s: a planar velocity (m/s, world frame) instead; the open floor's
             tracker (:func:`algorithms.motion.track_velocity`) turns it into ``(v, omega)``
             from the robot's sensed heading.

@@ -208,7 +208,8 @@ class RoleSwitchingRobot(Controller):
         ident: the robot's id.
         role: its initial role.
         params: :class:`RoleParams`.
-        parent, child: initial parent / child ids (repeaters, local leader, base station).
+        parent: initial parent id (repeaters, local leader, base station).
+        child: initial child id (repeaters, local leader, base station).
         connections: its initial connections ``A_i`` (the deployment's base station -
             local leader link).
         target: the base station's first :class:`Target` (the next ones come as messages).

@@ -77,7 +77,8 @@ class RayCaster:
     """Nearest-hit queries on one compiled world with N robots.
 
     Args:
-        model, data: the world; ``data`` must hold current kinematics (geom and body poses,
+        model: the world's model.
+        data: the world's data; it must hold current kinematics (geom and body poses,
             e.g. after ``mj_kinematics``) when the caster is built and when it casts.
         robot_bodies: (N,) root body id of each robot.
         geom_robot: (ngeom,) robot index owning each geom, -1 for others.

@@ -125,8 +125,9 @@ class Simulation:
         spec: an uncompiled world from :func:`mjswarm.core.world.world_spec` (robots ``r0``...).
         control_hz: control / sensing rate (Hz); must divide the physics rate.
         seed: seeds the sensor noise generator.
-        line_noise_m, ir_noise_m: standard deviation of Gaussian noise added to the line
-            and IR rangefinder readings (m) that saw something; 0 by default.
+        line_noise_m: standard deviation of Gaussian noise added to the line
+            rangefinder readings (m) that saw something; 0 by default.
+        ir_noise_m: the same for the IR rangefinders (m); 0 by default.
         sensing: ``"grid"`` (O(N) ray casting), ``"mujoco"`` (MuJoCo's sensors) or
             ``"auto"``; see the module docstring.
         wheel_slip: wheel slip seen by the encoders: each control tick, each wheel's

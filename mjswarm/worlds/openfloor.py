@@ -70,7 +70,8 @@ class MotionWorld(World, ABC):
         positions: start positions (m), one per robot; ``present`` says which are on the
             floor (the rest wait in the depot).
         seed: seeds the position-sensor noise.
-        position_noise_m, heading_noise_rad: standard deviations of the positioning sensor.
+        position_noise_m: standard deviation of the positioning sensor's position (m).
+        heading_noise_rad: standard deviation of its heading (rad).
         omega_max_rad_s: turn-rate cap of the velocity tracker (a paper may set its own).
         control_dt_s: the control period (s) of :meth:`step`.
         detection_range_m: range of the range-and-bearing sensor (m); None: no sensor.

@@ -133,7 +133,8 @@ def run_check(
         initiator: the robot that starts the check (stamps) or is the reference (tables);
             default the team's first robot.
         max_robots: N of Ahmadi & Stone Assumption 1 (default n); sets the timing.
-        drop_prob, seed: radio message loss (the papers assume none).
+        drop_prob: probability that the radio loses a message (the papers assume none).
+        seed: seeds the radio's losses.
         message_cap: stop once more messages than this were sent (None: no cap).
     """
     if method not in METHODS:
