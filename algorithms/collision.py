@@ -193,11 +193,6 @@ class CollisionRule:
                 return slope / self.dt, y_mean + slope * (w - 1 - t_mean)
         return None
 
-    def bearing_rate(self, p: int) -> float | None:
-        """The fitted ``d beta_kp / dt`` (rad/s) of :meth:`fit`, None while it cannot tell."""
-        fitted = self.fit(p)
-        return None if fitted is None else fitted[0]
-
     def update(self, bearings: dict[int, float]) -> float:
         """Take this tick's bearings ``{p: beta_kp}`` (rad) and return ``S_k`` (m/s)."""
         for p in list(self._history):

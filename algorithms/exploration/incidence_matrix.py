@@ -333,11 +333,6 @@ class IncidenceMatrix:
         chosen = self._selections
         return frozenset([r for r, bit in self.numbering.choices[i].items() if chosen & bit])
 
-    @property
-    def n_ends(self) -> int:
-        """Number of non-zero entries the matrix would have if fully explored."""
-        return self._ends.bit_count()
-
     def is_complete(self, source: str | None = None, root: str | None = None) -> bool:
         """Theorem 1: exploration is complete iff ``Eu`` and ``Eo`` are empty, i.e. every
         end of every known vertex belongs to a completed edge (Remark 5: the rightmost

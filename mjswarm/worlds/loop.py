@@ -258,13 +258,11 @@ class LoopFunctions:
 class Loop:
     """Runs ``controllers`` (by robot id) in ``world`` with ``functions``' hooks.
 
-    ``halted`` holds the robots the loop no longer steps (a robot that failed); loop
-    functions add to it with :meth:`halt`. ``stepped`` lists the robots stepped in the
-    last tick, in order, and ``reports`` what they reported (``(robot, event)`` pairs
-    from their commands' ``events``, in order): what loop functions learn of a robot's
-    mind, never its attributes. A robot's controller is reset (:meth:`Controller.reset`) when the
-    robot enters the floor: before its first step, and again after each time it was
-    off the floor.
+    ``stepped`` lists the robots stepped in the last tick, in order, and ``reports`` what
+    they reported (``(robot, event)`` pairs from their commands' ``events``, in order):
+    what loop functions learn of a robot's mind, never its attributes. A robot's
+    controller is reset (:meth:`Controller.reset`) when the robot enters the floor:
+    before its first step, and again after each time it was off the floor.
 
     A ``team`` (:class:`~algorithms.batch.BatchController`) drives every robot of the
     world as arrays, in the same phases: its robots are sensed in one call
@@ -282,7 +280,6 @@ class Loop:
         self.controllers: dict[int, Controller] = dict(controllers)
         self.functions: list[LoopFunctions] = []
         self.ticks = 0
-        self.halted: set[int] = set()
         self.stepped: list = []
         self.reports: list[tuple[Any, Any]] = []
         #: whether any controller (a robot's or a fixed node's) has a perceive() of its own
@@ -297,11 +294,6 @@ class Loop:
         """Hook in one more loop function (a recording, a video); it is initialized now."""
         self.functions.append(function)
         function.initialize(self)
-
-    def halt(self, robot: int) -> None:
-        """Stop stepping ``robot`` for good (its body stays where it is, standing still)."""
-        self.halted.add(robot)
-        self.world.act(robot, Command())
 
     def stop(self) -> None:
         """End the run after the current tick (from a hook)."""
@@ -323,8 +315,6 @@ class Loop:
         for f in self.functions:
             f.before_step(self)
         robots = world.active()
-        if self.halted:
-            robots = [i for i in robots if i not in self.halted]
         self._enter(robots)
         team, members = self.team, ()
         if team is not None:  # the team's robots are stepped as arrays, the nodes one by one
