@@ -165,7 +165,7 @@ def open_viewer(path: str | Path) -> int:
     if not has_display():
         raise MjswarmError(
             f"no display (DISPLAY and WAYLAND_DISPLAY are unset), cannot open the viewer; "
-            f"copy {path} to a machine with a display and run `mjswarm view {path.name}`"
+            f"serve it to a browser with `mjswarm view {path} --web`"
         )
     return subprocess.call([*rerun_command(), str(path)])
 

@@ -102,6 +102,59 @@ def serve(files: list[str | Path], timeout_s: float = 30.0) -> Iterator[str]:
         log.close()
 
 
+def serve_web(path: str | Path, port: int | None = None, grpc_port: int | None = None,
+              out=None) -> int:
+    """``mjswarm view --web``: serve the recording at ``path`` with rerun's web viewer on
+    127.0.0.1 (the page on ``port``, default a free one; the data on ``grpc_port``),
+    print the address to open, and serve until interrupted (Ctrl-C raises
+    :class:`KeyboardInterrupt` after the server is stopped) or until the server exits
+    (its exit status). Raises :class:`MjswarmError` if the file is not a recording or a
+    port is taken."""
+    import sys
+
+    check_recording(path)
+    web = free_port() if port is None else port
+    grpc = free_port() if grpc_port is None else grpc_port
+    for p in (web, grpc):
+        if port_open(p):
+            raise MjswarmError(f"port {p} on 127.0.0.1 is in use; pick another with --port")
+    out = sys.stdout if out is None else out
+    proc = subprocess.Popen(serve_command([path], web, grpc), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, env=viewer_env())
+    try:
+        deadline = time.monotonic() + 30.0
+        while not (port_open(web) and port_open(grpc)):
+            if proc.poll() is not None:
+                raise MjswarmError(f"rerun's web viewer exited with status {proc.returncode}")
+            if time.monotonic() > deadline:
+                raise MjswarmError("rerun's web viewer did not start within 30 s")
+            time.sleep(0.1)
+        print(f"serving {Path(path).name}: open {web_address(web, grpc)}\n"
+              f"(from another machine: ssh -L {web}:127.0.0.1:{web} -L "
+              f"{grpc}:127.0.0.1:{grpc} HOST, then the same address); Ctrl-C stops",
+              file=out, flush=True)
+        return proc.wait()
+    finally:
+        if proc.poll() is None:
+            proc.terminate()
+            try:
+                proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+
+
+def check_recording(path: str | Path) -> None:
+    """Refuse, in one line, a path that is no rerun recording (rerun's files start
+    with ``RRF``)."""
+    path = Path(path)
+    if not path.is_file():
+        raise MjswarmError(f"no recording at {path}")
+    with path.open("rb") as f:
+        if f.read(3) != b"RRF":
+            raise MjswarmError(f"{path} is not a rerun .rrd recording")
+
+
 def single_view_blueprint(view, path: str | Path) -> Path:
     """Save a blueprint (``.rbl``) that shows ``view`` (a rerun blueprint view) alone,
     with the side panels collapsed and the time panel following the data to its end."""
