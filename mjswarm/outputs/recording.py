@@ -695,7 +695,7 @@ def graph_scale(vertices, bounds_m: tuple[float, float, float, float]) -> float:
 
 
 def top_down_eye(bounds_m: tuple[float, float, float, float], aspect: float = 1.35,
-                 margin_m: float = 0.2) -> rrb.EyeControls3D:
+                 margin_m: float = 0.3) -> rrb.EyeControls3D:
     """A camera straight above the middle of ``bounds_m`` (m), x to the right and y up,
     high enough that the area and ``margin_m`` around it fill a view ``aspect`` times as
     wide as it is tall (rerun's 3-D view sees :data:`_FOV_Y_DEG` degrees vertically)."""

@@ -1,0 +1,87 @@
+"""A recording as a reader sees it: served with rerun's own web viewer on 127.0.0.1 and
+opened in a headless Chromium (selenium, the system's chromedriver; nothing downloaded).
+
+One page load (some 20-40 s): the default layout, once the data has loaded, must show
+every robot's colour in the arena view and no empty view; and, from the recording's data,
+every map view's vertices must stand farther apart than a label is wide in rerun's graph
+units (else the labels stack on one spot). The screenshot is kept under ``tmp_path``.
+``MJSWARM_BROWSER_RRD=FILE.rrd`` checks that recording instead of a fresh one.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+import rerun as rr
+
+from mjswarm.cli import main
+from mjswarm.outputs.recording import robot_color
+from mjswarm.outputs.webview import Browser, browser_missing, serve
+
+#: Width of a vertex label in rerun's graph view (its units), with room to spare.
+LABEL_UNITS = 60.0
+#: Where the default layout puts its views, as fractions (x0, y0, x1, y1) of the page.
+REGIONS = {"arena": (0.02, 0.08, 0.48, 0.62), "map": (0.52, 0.10, 0.98, 0.38),
+           "matrix": (0.52, 0.44, 0.98, 0.66), "events": (0.02, 0.76, 0.48, 0.90),
+           "controller state": (0.52, 0.78, 0.98, 0.90)}
+
+pytestmark = pytest.mark.skipif(browser_missing() is not None,
+                                reason=f"no browser test: {browser_missing()}")
+
+
+def map_positions(path: Path) -> dict[str, list[np.ndarray]]:
+    """Robot map entity -> the node positions (graph units) of each map logged."""
+    maps: dict[str, list[np.ndarray]] = {}
+    for chunk in rr.chunk.RrdReader(path).stream():
+        if not chunk.entity_path.startswith("/map/"):
+            continue
+        batch = chunk.to_record_batch()
+        if "GraphNodes:positions" in batch.schema.names:
+            for row in batch.column("GraphNodes:positions").to_pylist():
+                if row:
+                    maps.setdefault(chunk.entity_path, []).append(np.array(row, float))
+    return maps
+
+
+def region(pixels: np.ndarray, name: str) -> np.ndarray:
+    x0, y0, x1, y1 = REGIONS[name]
+    h, w, _ = pixels.shape
+    return pixels[int(y0 * h):int(y1 * h), int(x0 * w):int(x1 * w)]
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory) -> Path:
+    given = os.environ.get("MJSWARM_BROWSER_RRD")
+    if given:
+        return Path(given)
+    path = tmp_path_factory.mktemp("browser") / "fig9.rrd"
+    main(["explore", "--arena", "fig9", "--robots", "2", "--max-time", "80",
+          "--record", str(path)])
+    assert path.is_file()
+    return path
+
+
+def test_map_vertices_stand_farther_apart_than_a_label(recording):
+    maps = map_positions(recording)
+    assert maps, "no explored map in the recording"
+    for entity, logged in maps.items():
+        for xy in logged:
+            if len(xy) > 1:
+                d = np.hypot(*(xy[:, None] - xy[None]).transpose(2, 0, 1))
+                closest = d[np.triu_indices(len(xy), 1)].min()
+                assert closest > LABEL_UNITS, (entity, closest)
+
+
+def test_default_layout_in_a_browser(recording, tmp_path):
+    with serve([recording]) as address, Browser() as browser:
+        browser.look(address)
+        pixels = browser.save(tmp_path / "default_layout.png")
+    for name in REGIONS:
+        assert region(pixels, name).std() > 3.0, f"the {name} view is empty"
+    arena = region(pixels, "arena").astype(int)
+    for i in range(2):
+        near = (np.abs(arena - np.array(robot_color(i)[:3])) < 30).all(axis=2)
+        assert near.sum() >= 30, f"R{i + 1}'s colour is not in the arena view"
