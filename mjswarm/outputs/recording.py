@@ -267,7 +267,7 @@ class Recorder:
         self._stream.set_log_time_enabled(False)
         self._stream.send_recording_name(name or f"{arena.name}, {n} robots")
         self._stream.send_blueprint(_blueprint(bounds_m, n, trail_window_s, radio, sensors,
-                                               video))
+                                               video, self.graph_scale))
         self._closed = False
         self._buffers(self._chunk, n)
         self._log_static(arena, float(robot_radius_m))
@@ -708,9 +708,18 @@ def top_down_eye(bounds_m: tuple[float, float, float, float], aspect: float = 1.
         eye_up=(0.0, 1.0, 0.0))
 
 
+def graph_bounds(bounds_m: tuple[float, float, float, float], scale: float,
+                 margin_m: float = 0.3) -> rrb.VisualBounds2D:
+    """What a graph view shows: ``bounds_m`` (m) and ``margin_m`` around them, in graph
+    units (``scale`` per metre, y negated as the graphs are logged)."""
+    x0, y0, x1, y1 = bounds_m
+    return rrb.VisualBounds2D(x_range=[scale * (x0 - margin_m), scale * (x1 + margin_m)],
+                              y_range=[-scale * (y1 + margin_m), -scale * (y0 - margin_m)])
+
+
 def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
                trail_window_s: float, radio: bool, sensors: bool,
-               video: bool = False) -> rrb.Blueprint:
+               video: bool = False, scale: float = 1.0) -> rrb.Blueprint:
     """The layout the file opens with, on the ``sim_time`` timeline, following the data
     to its end: on the left the arena seen from above (strips, walls, named vertices,
     robots in their colours with their headings and trails, radio links) over the event
@@ -734,14 +743,16 @@ def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
         eye_controls=top_down_eye(bounds_m),
         line_grid=rrb.LineGrid3D(visible=False),
     )
+    frame = graph_bounds(bounds_m, scale)  # every graph in the arena's frame
     if n_robots <= MAP_TAB_LIMIT:
-        maps = [rrb.Vertical(rrb.GraphView(name=f"map {r}", origin=f"/map/{r}"),
+        maps = [rrb.Vertical(rrb.GraphView(name=f"map {r}", origin=f"/map/{r}",
+                                           visual_bounds=frame),
                              rrb.TextDocumentView(name=f"incidence matrix {r}",
                                                   origin=f"/matrices/{r}"),
                              name=r, row_shares=[1, 1]) for r in robots]
     else:
-        maps = [rrb.GraphView(name="maps", origin="/map")]
-    radio_views = [rrb.GraphView(name="radio", origin="/radio/graph"),
+        maps = [rrb.GraphView(name="maps", origin="/map", visual_bounds=frame)]
+    radio_views = [rrb.GraphView(name="radio", origin="/radio/graph", visual_bounds=frame),
                    rrb.TextDocumentView(name="radio truth", origin="/radio/truth")]
     graphs = rrb.Tabs(*maps, rrb.TextDocumentView(name="beacons", origin="/beacons"),
                       *(radio_views if radio else []))

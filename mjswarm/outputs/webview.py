@@ -209,23 +209,32 @@ class Browser:
         driver = CHROMEDRIVER if Path(CHROMEDRIVER).exists() else shutil.which("chromedriver")
         self.driver = webdriver.Chrome(service=Service(driver), options=options)
 
-    def look(self, address: str, settle_s: float = 4.0, timeout_s: float = 90.0) -> np.ndarray:
+    def look(self, address: str, settle_s: float = 4.0, timeout_s: float = 150.0,
+             strict: bool = True) -> np.ndarray:
         """Open ``address`` and wait until the page has drawn the data: its pixels vary
         (not a blank page) and have not changed for ``settle_s``. Returns the pixels of
-        the last screenshot; raises :class:`MjswarmError` after ``timeout_s``."""
+        the last screenshot; after ``timeout_s`` raises :class:`MjswarmError` (``strict``)
+        or returns them as they are."""
         self.driver.get(address)
         deadline = time.monotonic() + timeout_s
         last, since = None, time.monotonic()
+        from selenium.common.exceptions import TimeoutException
+
         while True:
             time.sleep(1.0)
-            now = image(self.driver.get_screenshot_as_png())
+            try:
+                now = image(self.driver.get_screenshot_as_png())
+            except TimeoutException:  # a busy renderer: try again
+                continue
             if last is None or now.shape != last.shape or np.abs(
                     now.astype(int) - last).mean() > 0.05 or now.std() < 5:
                 last, since = now, time.monotonic()
             elif time.monotonic() - since >= settle_s:
                 return now
             if time.monotonic() > deadline:
-                raise MjswarmError(f"the web viewer did not settle within {timeout_s:g} s")
+                if strict or last is None:
+                    raise MjswarmError(f"the web viewer did not settle within {timeout_s:g} s")
+                return last
 
     def save(self, path: str | Path) -> np.ndarray:
         """Save a screenshot of the page as a PNG at ``path``; returns its pixels."""
@@ -245,9 +254,10 @@ class Browser:
 
 
 def screenshot(recording: str | Path, out: str | Path, view=None,
-               browser: Browser | None = None) -> np.ndarray:
+               browser: Browser | None = None, strict: bool = True) -> np.ndarray:
     """Serve ``recording`` (with ``view`` alone when given), open it in ``browser`` (a
-    new one when None) and save the settled page as ``out`` (PNG); returns its pixels."""
+    new one when None) and save the settled page as ``out`` (PNG); returns its pixels.
+    ``strict``: as :meth:`Browser.look`."""
     with contextlib.ExitStack() as stack:
         files: list[str | Path] = [recording]
         if view is not None:
@@ -256,5 +266,5 @@ def screenshot(recording: str | Path, out: str | Path, view=None,
         address = stack.enter_context(serve(files))
         if browser is None:
             browser = stack.enter_context(Browser())
-        browser.look(address)
+        browser.look(address, strict=strict)
         return browser.save(out)
