@@ -75,7 +75,7 @@ def test_fig9_graph_recording_shows_the_papers_sequences(graph_recordings):
 def test_connected_graph_recording_has_the_tethers(graph_recordings):
     names = {chunk.entity_path for chunk in rr.chunk.RrdReader(
         graph_recordings["connected"]).stream()}
-    assert {"/radio/graph", "/radio/tethers", "/states/R2", "/robots/R3/state/parent",
+    assert {"/radio/graph", "/radio/tethers", "/states/R2/mode", "/states/R2/decision", "/robots/R3/state/parent",
             "/map/R3", "/matrices/R3"} <= names
 
 

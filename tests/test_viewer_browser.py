@@ -4,7 +4,8 @@ opened in a headless Chromium (selenium, the system's chromedriver; nothing down
 One page load (some 20-40 s): the default layout, once the data has loaded, must show
 every robot's colour in the arena view and no empty view; and, from the recording's data,
 every map view's vertices must stand farther apart than a label is wide in rerun's graph
-units (else the labels stack on one spot). The screenshot is kept under ``tmp_path``.
+units (else the labels stack on one spot). The screenshot, and each view cut out of it,
+are kept under ``tmp_path``.
 ``MJSWARM_BROWSER_RRD=FILE.rrd`` checks that recording instead of a fresh one.
 """
 
@@ -19,14 +20,11 @@ import rerun as rr
 
 from mjswarm.cli import main
 from mjswarm.outputs.recording import robot_color
-from mjswarm.outputs.webview import Browser, browser_missing, serve
+from mjswarm.outputs.webview import (LAYOUT_REGIONS, Browser, browser_missing, crop,
+                                    save_png, serve)
 
 #: Width of a vertex label in rerun's graph view (its units), with room to spare.
 LABEL_UNITS = 60.0
-#: Where the default layout puts its views, as fractions (x0, y0, x1, y1) of the page.
-REGIONS = {"arena": (0.02, 0.08, 0.48, 0.62), "map": (0.52, 0.10, 0.98, 0.38),
-           "matrix": (0.52, 0.44, 0.98, 0.66), "events": (0.02, 0.76, 0.48, 0.90),
-           "controller state": (0.52, 0.78, 0.98, 0.90)}
 
 pytestmark = pytest.mark.skipif(browser_missing() is not None,
                                 reason=f"no browser test: {browser_missing()}")
@@ -44,12 +42,6 @@ def map_positions(path: Path) -> dict[str, list[np.ndarray]]:
                 if row:
                     maps.setdefault(chunk.entity_path, []).append(np.array(row, float))
     return maps
-
-
-def region(pixels: np.ndarray, name: str) -> np.ndarray:
-    x0, y0, x1, y1 = REGIONS[name]
-    h, w, _ = pixels.shape
-    return pixels[int(y0 * h):int(y1 * h), int(x0 * w):int(x1 * w)]
 
 
 @pytest.fixture(scope="module")
@@ -79,9 +71,11 @@ def test_default_layout_in_a_browser(recording, tmp_path):
     with serve([recording]) as address, Browser() as browser:
         browser.look(address)
         pixels = browser.save(tmp_path / "default_layout.png")
-    for name in REGIONS:
-        assert region(pixels, name).std() > 3.0, f"the {name} view is empty"
-    arena = region(pixels, "arena").astype(int)
+    for name in LAYOUT_REGIONS:
+        view = crop(pixels, name)
+        save_png(view, tmp_path / f"{name}.png")
+        assert view.std() > 3.0, f"the {name} view is empty"
+    arena = crop(pixels, "arena").astype(int)
     for i in range(2):
         near = (np.abs(arena - np.array(robot_color(i)[:3])) < 30).all(axis=2)
         assert near.sum() >= 30, f"R{i + 1}'s colour is not in the arena view"

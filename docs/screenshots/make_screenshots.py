@@ -4,8 +4,9 @@ Makes the recordings (the main job, ``mjswarm explore --arena arena2 --robots 4`
 003's Fig. 9 in the graph world, plain and connected with a 1.5 m radio; a patrol in the
 point world), serves each with rerun's web viewer on 127.0.0.1, opens it in a headless
 Chromium (:mod:`mjswarm.outputs.webview`: needs ``apt-get install chromium
-chromium-driver`` and selenium) and saves the default layout, plus single views of the
-Fig. 9 run (R2's map and incidence matrix, the beacons). Run from the repository root::
+chromium-driver`` and selenium) and saves the default layout as ``NAME.png``, and for the
+Fig. 9 graph run and the main job each view of it as ``NAME_VIEW.png``. Run from the
+repository root::
 
     python docs/screenshots/make_screenshots.py [--only NAME ...]
 """
@@ -17,10 +18,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-import rerun.blueprint as rrb
-
 from mjswarm.cli import main
-from mjswarm.outputs.webview import Browser, screenshot
+from mjswarm.outputs.webview import LAYOUT_REGIONS, Browser, crop, save_png, screenshot
 
 HERE = Path(__file__).resolve().parent
 #: name -> the mjswarm command line that records it (``--record`` added).
@@ -32,40 +31,27 @@ RUNS = {
     "patrol": ["experiment", "patrol", "--world", "point", "--robots", "8",
                "--steps", "400"],
 }
-#: name -> (recording, the view shown alone)
-VIEWS = {
-    "fig9_graph_R2": ("fig9_graph", rrb.Vertical(
-        rrb.GraphView(name="map R2", origin="/map/R2"),
-        rrb.TextDocumentView(name="incidence matrix R2", origin="/matrices/R2"))),
-    "fig9_graph_beacons": ("fig9_graph", rrb.TextDocumentView(name="beacons",
-                                                              origin="/beacons")),
-    "fig9_connected_radio": ("fig9_connected", rrb.GraphView(name="radio",
-                                                              origin="/radio/graph")),
-}
+#: Recordings whose views are also saved one by one, cut out of the default layout.
+VIEWS = ("fig9_graph", "main_job")
 
 
 def run() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", nargs="*", choices=[*RUNS, *VIEWS], default=None)
+    parser.add_argument("--only", nargs="*", choices=list(RUNS), default=None)
     args = parser.parse_args()
-    wanted = set(args.only or [*RUNS, *VIEWS])
-    needed = {n for n in RUNS if n in wanted} | {VIEWS[v][0] for v in VIEWS if v in wanted}
+    wanted = args.only or list(RUNS)
     with tempfile.TemporaryDirectory() as tmp, Browser() as browser:
-        files = {}
-        for name in RUNS:
-            if name in needed:
-                files[name] = Path(tmp) / f"{name}.rrd"
-                print(f"recording {name}: mjswarm {' '.join(RUNS[name])}", flush=True)
-                main([*RUNS[name], "--record", str(files[name])])
-        for name in RUNS:
-            if name in wanted:
-                screenshot(files[name], HERE / f"{name}.png", browser=browser, strict=False)
-                print(f"wrote {HERE / f'{name}.png'}", flush=True)
-        for name, (source, view) in VIEWS.items():
-            if name in wanted:
-                screenshot(files[source], HERE / f"{name}.png", view=view, browser=browser,
-                           strict=False)
-                print(f"wrote {HERE / f'{name}.png'}", flush=True)
+        for name in wanted:
+            path = Path(tmp) / f"{name}.rrd"
+            print(f"recording {name}: mjswarm {' '.join(RUNS[name])}", flush=True)
+            main([*RUNS[name], "--record", str(path)])
+            pixels = screenshot(path, HERE / f"{name}.png", browser=browser, strict=False)
+            print(f"wrote {HERE / f'{name}.png'}", flush=True)
+            if name in VIEWS:
+                for view in LAYOUT_REGIONS:
+                    out = HERE / f"{name}_{view.replace(' ', '_')}.png"
+                    save_png(crop(pixels, view), out)
+                    print(f"wrote {out}", flush=True)
     return 0
 
 

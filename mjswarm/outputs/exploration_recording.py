@@ -312,7 +312,7 @@ class GraphExplorationRecording(LoopFunctions):
         for i, values in state.items():
             mode = values.get("mode")
             if mode is not None:
-                rec.log_state(step, now, i, MODES[int(mode)], changes_only=True)
+                rec.log_state(step, now, i, MODES[int(mode)], "mode", changes_only=True)
         base = {name: xy for name, xy in world.fixed.items()}
         edges = [tuple(e) for e in world.radio.graph().edges]
         parents = {i: int(v["parent"]) for i, v in state.items() if "parent" in v}

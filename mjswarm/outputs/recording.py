@@ -23,8 +23,8 @@ is right-handed, z up, the floor at z = 0)::
     robots/R<k>/battery       Scalars per tick: battery terminal voltage (V)
     robots/R<k>/bearings/R<j> Scalars (drawn as points) at ticks where R<k> sees R<j>
     robots/R<k>/state         Scalars per tick: the controller's telemetry, one series a name
-    states/R<k>               StateChange: the controller's state (its decision at a vertex
-                              call, its mode) when it changes
+    states/R<k>/decision      StateChange: its decision at each vertex call (go, idle, done)
+    states/R<k>/mode          StateChange: its mode (a tethered robot's), when it changes
     map/R<k>                  GraphNodes + GraphEdges: robot R<k>'s explored graph, in graph
                               units (:attr:`Recorder.graph_scale` units per metre)
     matrices/R<k>             TextDocument (markdown): the incidence matrix R<k> carries,
@@ -267,7 +267,8 @@ class Recorder:
         self._stream.set_log_time_enabled(False)
         self._stream.send_recording_name(name or f"{arena.name}, {n} robots")
         self._stream.send_blueprint(_blueprint(bounds_m, n, trail_window_s, radio, sensors,
-                                               video, self.graph_scale))
+                                               video, self.graph_scale,
+                                               maps=arena is not None))
         self._closed = False
         self._buffers(self._chunk, n)
         self._log_static(arena, float(robot_radius_m))
@@ -290,7 +291,7 @@ class Recorder:
         self._trail_from: np.ndarray | None = None  # (n, 2): last position already sent
         self._latest_xy: np.ndarray | None = None  # (n, 2): last position logged
         self._last_map: dict[int, tuple] = {}
-        self._last_state: dict[int, str] = {}
+        self._last_state: dict[tuple[int, str], str] = {}
         self._state: dict[tuple[int, str], tuple[list[int], list[float]]] = {}
 
     # --- static data -------------------------------------------------------------------
@@ -542,14 +543,15 @@ class Recorder:
         )
 
     def log_state(self, step: int, sim_time_s: float, robot: int, state: str,
-                  changes_only: bool = False) -> None:
-        """Robot ``robot``'s controller enters ``state`` (a name); with ``changes_only``,
-        nothing is logged while the state stays the same."""
-        if changes_only and self._last_state.get(robot) == state:
+                  lane: str = "decision", changes_only: bool = False) -> None:
+        """Robot ``robot``'s controller enters ``state`` (a name) in ``lane``
+        (``states/R<k>/<lane>``); with ``changes_only``, nothing is logged while the
+        state stays the same."""
+        if changes_only and self._last_state.get((robot, lane)) == state:
             return
-        self._last_state[robot] = state
+        self._last_state[(robot, lane)] = state
         self._at(step, sim_time_s)
-        self._stream.log(f"states/{robot_name(robot)}", rr.StateChange(state=state))
+        self._stream.log(f"states/{robot_name(robot)}/{lane}", rr.StateChange(state=state))
 
     def log_matrix(self, step: int, sim_time_s: float, robot: int, markdown: str) -> None:
         """The incidence matrix robot ``robot`` carries, as a markdown document."""
@@ -719,13 +721,13 @@ def graph_bounds(bounds_m: tuple[float, float, float, float], scale: float,
 
 def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
                trail_window_s: float, radio: bool, sensors: bool,
-               video: bool = False, scale: float = 1.0) -> rrb.Blueprint:
+               video: bool = False, scale: float = 1.0, maps: bool = True) -> rrb.Blueprint:
     """The layout the file opens with, on the ``sim_time`` timeline, following the data
     to its end: on the left the arena seen from above (strips, walls, named vertices,
     robots in their colours with their headings and trails, radio links) over the event
     log; on the right, one tab per robot with its explored graph over the incidence
-    matrix it carries (all graphs in one view above :data:`MAP_TAB_LIMIT` robots), the
-    beacons (and the radio graph), over the time series (controller state, speeds, and
+    matrix it carries (all graphs in one view above :data:`MAP_TAB_LIMIT` robots) and
+    the beacons, for runs on an arena (``maps``), and the radio graph, over the time series (controller state, speeds, and
     the sensors when recorded). The blueprint, selection and time panels start
     collapsed (the time panel to its one-line bar)."""
     robots = [robot_name(i) for i in range(n_robots)]
@@ -744,26 +746,29 @@ def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
         line_grid=rrb.LineGrid3D(visible=False),
     )
     frame = graph_bounds(bounds_m, scale)  # every graph in the arena's frame
-    if n_robots <= MAP_TAB_LIMIT:
+    if not maps:
+        maps = []
+    elif n_robots <= MAP_TAB_LIMIT:
         maps = [rrb.Vertical(rrb.GraphView(name=f"map {r}", origin=f"/map/{r}",
                                            visual_bounds=frame),
                              rrb.TextDocumentView(name=f"incidence matrix {r}",
                                                   origin=f"/matrices/{r}"),
-                             name=r, row_shares=[1, 1]) for r in robots]
+                             name=r, row_shares=[3, 2]) for r in robots]
     else:
         maps = [rrb.GraphView(name="maps", origin="/map", visual_bounds=frame)]
     radio_views = [rrb.GraphView(name="radio", origin="/radio/graph", visual_bounds=frame),
                    rrb.TextDocumentView(name="radio truth", origin="/radio/truth")]
-    graphs = rrb.Tabs(*maps, rrb.TextDocumentView(name="beacons", origin="/beacons"),
-                      *(radio_views if radio else []))
+    beacons = [rrb.TextDocumentView(name="beacons", origin="/beacons")] if maps else []
+    graphs = [*maps, *beacons, *(radio_views if radio else [])]
 
     def plot(name: str, leaf: str) -> rrb.TimeSeriesView:
         return rrb.TimeSeriesView(name=name, origin="/robots",
                                   contents=[f"+ /robots/{r}/{leaf}" for r in robots])
 
+    states = [rrb.StateTimelineView(name="controller state", origin="/states"),
+              plot("telemetry", "state/**")]
     series = rrb.Tabs(
-        rrb.StateTimelineView(name="controller state", origin="/states"),
-        plot("telemetry", "state/**"),
+        *(states if maps else states[::-1]),
         plot("speed (m/s)", "speed"),
         *([plot("line sensors (m)", "sensors/line"),
            plot("IR (m)", "sensors/ir"),
@@ -777,7 +782,7 @@ def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
         rrb.Horizontal(
             rrb.Vertical(scene, rrb.TextLogView(name="events", origin="/events"),
                          row_shares=[3, 1]),
-            rrb.Vertical(graphs, series, row_shares=[3, 1]),
+            rrb.Vertical(rrb.Tabs(*graphs), series, row_shares=[4, 1]) if graphs else series,
             column_shares=[1, 1],
         ),
         rrb.BlueprintPanel(state="collapsed"),

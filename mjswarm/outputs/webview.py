@@ -6,11 +6,7 @@ gives the page to open. :class:`Browser` drives a headless Chromium through the 
 chromedriver (selenium; nothing is downloaded): it opens that page, waits until the
 viewer has drawn the data (the page's pixels stop changing) and saves screenshots.
 ``mjswarm view --web``, the browser test and ``docs/screenshots/make_screenshots.py``
-use these.
-
-A single view of a recording is shown by serving a blueprint (``.rbl``) with that view
-alone beside the file (:func:`single_view_blueprint`): the viewer takes the last
-blueprint it is given.
+use these; :func:`crop` cuts one view out of a screenshot of the default layout.
 """
 
 from __future__ import annotations
@@ -30,7 +26,7 @@ from urllib.parse import quote
 import numpy as np
 
 from mjswarm.errors import MjswarmError
-from mjswarm.outputs.recording import APPLICATION_ID, rerun_command
+from mjswarm.outputs.recording import rerun_command
 
 #: Where Debian puts Chromium and its driver (``apt-get install chromium chromium-driver``).
 CHROMIUM = "/usr/bin/chromium"
@@ -76,7 +72,7 @@ def viewer_env() -> dict[str, str]:
 
 @contextlib.contextmanager
 def serve(files: list[str | Path], timeout_s: float = 30.0) -> Iterator[str]:
-    """Serve ``files`` (a ``.rrd`` and optionally a ``.rbl``) with rerun's web viewer on
+    """Serve ``files`` (``.rrd`` recordings) with rerun's web viewer on
     127.0.0.1 while the context lasts; yields the address to open. Raises
     :class:`MjswarmError` if the server does not listen within ``timeout_s``."""
     web, grpc = free_port(), free_port()
@@ -155,16 +151,26 @@ def check_recording(path: str | Path) -> None:
             raise MjswarmError(f"{path} is not a rerun .rrd recording")
 
 
-def single_view_blueprint(view, path: str | Path) -> Path:
-    """Save a blueprint (``.rbl``) that shows ``view`` (a rerun blueprint view) alone,
-    with the side panels collapsed and the time panel following the data to its end."""
-    import rerun.blueprint as rrb
+#: Where the default layout (:func:`mjswarm.outputs.recording._blueprint`, exploration
+#: runs) puts its views in the page, as fractions (x0, y0, x1, y1) of its width and height.
+LAYOUT_REGIONS = {"arena": (0.0, 0.04, 0.5, 0.73), "map": (0.5, 0.07, 1.0, 0.46),
+                  "matrix": (0.5, 0.46, 1.0, 0.73), "events": (0.0, 0.73, 0.5, 0.95),
+                  "controller state": (0.5, 0.73, 1.0, 0.95)}
 
-    blueprint = rrb.Blueprint(view, rrb.BlueprintPanel(state="collapsed"),
-                              rrb.SelectionPanel(state="collapsed"),
-                              rrb.TimePanel(state="collapsed", play_state="following"))
-    blueprint.save(APPLICATION_ID, str(path))
-    return Path(path)
+
+def crop(pixels: np.ndarray, region: str) -> np.ndarray:
+    """The part of a screenshot of the default layout where ``region`` (a key of
+    :data:`LAYOUT_REGIONS`) is."""
+    x0, y0, x1, y1 = LAYOUT_REGIONS[region]
+    h, w, _ = pixels.shape
+    return pixels[int(y0 * h):int(y1 * h), int(x0 * w):int(x1 * w)]
+
+
+def save_png(pixels: np.ndarray, path: str | Path) -> None:
+    """Write (H, W, 3) uint8 pixels as a PNG."""
+    from PIL import Image
+
+    Image.fromarray(pixels).save(path)
 
 
 def browser_missing() -> str | None:
@@ -253,17 +259,13 @@ class Browser:
         self.close()
 
 
-def screenshot(recording: str | Path, out: str | Path, view=None,
-               browser: Browser | None = None, strict: bool = True) -> np.ndarray:
-    """Serve ``recording`` (with ``view`` alone when given), open it in ``browser`` (a
-    new one when None) and save the settled page as ``out`` (PNG); returns its pixels.
-    ``strict``: as :meth:`Browser.look`."""
+def screenshot(recording: str | Path, out: str | Path, browser: Browser | None = None,
+               strict: bool = True) -> np.ndarray:
+    """Serve ``recording``, open it in ``browser`` (a new one when None) and save the
+    settled page as ``out`` (PNG); returns its pixels. ``strict``: as
+    :meth:`Browser.look`."""
     with contextlib.ExitStack() as stack:
-        files: list[str | Path] = [recording]
-        if view is not None:
-            tmp = Path(stack.enter_context(tempfile.TemporaryDirectory()))
-            files.append(single_view_blueprint(view, tmp / "view.rbl"))
-        address = stack.enter_context(serve(files))
+        address = stack.enter_context(serve([recording]))
         if browser is None:
             browser = stack.enter_context(Browser())
         browser.look(address, strict=strict)
