@@ -104,7 +104,7 @@ TRAIL_WINDOW_S = 30.0
 MAP_TAB_LIMIT = 8
 #: Graph-view units between the two closest vertices of the arena (a label is at most
 #: some 60 units wide).
-GRAPH_SPACING = 150.0
+GRAPH_SPACING = 90.0
 #: Vertical field of view of rerun's 3-D view (degrees), for framing the arena.
 _FOV_Y_DEG = 55.0
 _TRAIL_Z_M = 0.004
