@@ -9,7 +9,7 @@ attributes. Beacons appear in them by id only.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 
 class Declared(NamedTuple):
@@ -23,8 +23,10 @@ class VertexCalled(NamedTuple):
     """The robot called its strategy at the vertex it stands on: whether it had just
     arrived by an edge (else a launch, an idle wake-up or a walk back), what it decided
     (``"go"`` along ``angle_rad``, ``"idle"``, ``"done"`` or ``"cut off"``), the beacon's
-    id after the call, what the beacon holds (its text, for reviewers) and the robot's map
-    then (pairs of beacon ids)."""
+    id after the call, what the beacon holds (its text, for reviewers), the robot's map
+    then (pairs of beacon ids) and the incidence matrix the beacon and the robot hold
+    after the call (an immutable :class:`~algorithms.exploration.incidence_matrix.
+    IncidenceMatrix`; None for a strategy whose beacons hold none)."""
 
     arrived: bool
     action: str
@@ -32,6 +34,7 @@ class VertexCalled(NamedTuple):
     beacon_id: str | None
     beacon_text: str
     map_edges: tuple[tuple[str, str], ...]
+    matrix: Any = None
 
 
 class Stopped(NamedTuple):

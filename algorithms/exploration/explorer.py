@@ -584,7 +584,8 @@ class Explorer(Controller):
         self.calls.append(VertexCall(now_s, beacon.id, arrived and not back, decision))
         mapped = tuple(self.strategy.map_edges())
         self._events.append(VertexCalled(arrived and not back, decision.action, decision.angle,
-                                         beacon.id, repr(beacon.data), mapped))
+                                         beacon.id, repr(beacon.data), mapped,
+                                         getattr(beacon.data, "matrix", None)))
         if decision.action == "go":
             self._departure = min(nav.edge_angles, key=lambda a: abs(
                 math.remainder(a - decision.angle, 2 * math.pi)))

@@ -18,18 +18,22 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from algorithms.exploration.base import Strategy, angle_gap
-from algorithms.exploration.events import Declared, Infeasible
-from algorithms.exploration.relay import ConnectedExplorer
+from algorithms.exploration.events import Declared, Infeasible, VertexCalled
+from algorithms.exploration.relay import MODES, ConnectedExplorer
+from algorithms.exploration.tether import BASE
 from algorithms.robot import STOP, Command, Controller, Observation
 
 
 class GraphExplorer(Controller):
     """Runs ``strategy`` at the vertex calls of a graph world (module docstring); build
     one with :func:`graph_explorer`, which adds the strategy's arrival bookkeeping when it
-    has any."""
+    has any. With ``report``, every call is also reported as a
+    :class:`~algorithms.exploration.events.VertexCalled` event (for a recording: each
+    costs the robot's map and its beacon's matrix, so sweeps go without)."""
 
-    def __init__(self, strategy: Strategy) -> None:
+    def __init__(self, strategy: Strategy, report: bool = False) -> None:
         self.strategy = strategy
+        self.report = report
         self._go: dict[float, Command] = {}  # by angle: a command per decision, made once
 
     def step(self, observation: Observation) -> Command:
@@ -38,6 +42,11 @@ class GraphExplorer(Controller):
             return STOP
         decision = self.strategy.on_vertex(observation.beacon, vertex.angles_rad,
                                            vertex.arrived_by_rad)
+        if self.report:
+            call = vertex_called(observation, decision, self.strategy)
+            events = (call, Declared(call.map_edges)) if decision.action == "done" else (call,)
+            return Command(edge_rad=decision.angle if decision.action == "go" else None,
+                           events=events)
         if decision.action == "go":
             command = self._go.get(decision.angle)
             if command is None:
@@ -62,10 +71,21 @@ class BookkeepingExplorer(GraphExplorer):
             self.strategy.arrive(observation.beacon, vertex.angles_rad, vertex.arrived_by_rad)
 
 
-def graph_explorer(strategy: Strategy) -> GraphExplorer:
-    """The controller that runs ``strategy`` in a graph world."""
+def vertex_called(observation: Observation, decision, strategy: Strategy) -> VertexCalled:
+    """The report of a vertex call: what ``strategy`` decided, the beacon after the call
+    and the strategy's map."""
+    beacon = observation.beacon
+    data = beacon.data
+    return VertexCalled(observation.vertex.arrived_by_rad is not None, decision.action,
+                        decision.angle, beacon.id, repr(data), tuple(strategy.map_edges()),
+                        getattr(data, "matrix", None))
+
+
+def graph_explorer(strategy: Strategy, report: bool = False) -> GraphExplorer:
+    """The controller that runs ``strategy`` in a graph world (``report``: it reports
+    its vertex calls, :class:`GraphExplorer`)."""
     keeps_books = type(strategy).arrive is not Strategy.arrive
-    return (BookkeepingExplorer if keeps_books else GraphExplorer)(strategy)
+    return (BookkeepingExplorer if keeps_books else GraphExplorer)(strategy, report)
 
 
 class TetheredExplorer(Controller):
@@ -84,17 +104,24 @@ class TetheredExplorer(Controller):
     hears, waits or speaks.
     """
 
-    def __init__(self, connected: ConnectedExplorer, constrained: bool = True) -> None:
+    def __init__(self, connected: ConnectedExplorer, constrained: bool = True,
+                 report: bool = False) -> None:
         self.connected = connected
         self.constrained = constrained
+        self.report = report
         self._ticks_per_unit = connected.tether.ticks_per_unit
         self._out: list = []  # what it heard to send on
         self._wanted = None  # the step the tether forbade it in this tick's move phase
         self._moved = self._back = False
 
     def telemetry(self) -> Mapping[str, float]:
-        """``relay_trips``: relay missions it set out on (rule 6)."""
-        return {"relay_trips": self.connected.relay_trips}
+        """``relay_trips``: relay missions it set out on (rule 6); ``mode``: the index of
+        its mode in :data:`~algorithms.exploration.relay.MODES`; ``parent``: its first
+        tether parent (a robot id; -1 for the base)."""
+        c = self.connected
+        parent = c.tether.parents[0] if c.tether.parents else BASE
+        return {"relay_trips": c.relay_trips, "mode": MODES.index(c.mode),
+                "parent": -1 if parent == BASE else parent}
 
     def perceive(self, observation: Observation) -> None:
         if observation.leg.answering:
@@ -121,10 +148,12 @@ class TetheredExplorer(Controller):
         steps, progress, edge_rad = leg.steps_m, leg.progress, None
         if vertex is not None:
             decision = c.on_vertex(observation.beacon, vertex.angles_rad, vertex.arrived_by_rad)
+            called = (vertex_called(observation, decision, c.mind),) if self.report else ()
             if decision.action == "done":
-                return Command(messages=out, events=(Declared(tuple(c.mind.map_edges())),))
+                return Command(messages=out,
+                               events=(*called, Declared(tuple(c.mind.map_edges()))))
             if decision.action == "idle":
-                return Command(messages=out)
+                return Command(messages=out, events=called)
             if decision.action != "go":
                 raise ValueError(f"robot {c.index + 1} answered an unknown decision "
                                  f"{decision!r}")
@@ -136,7 +165,8 @@ class TetheredExplorer(Controller):
         if sense and self.constrained and not c.tether.may_step(steps[sense < 0], leg.around_m):
             self._wanted, sense = steps[sense < 0], 0
         self._moved, self._back = sense != 0, sense < 0
-        return Command(float(sense), 0.0, None, out, None, edge_rad)
+        return Command(float(sense), 0.0, None, out, None, edge_rad,
+                       called if vertex is not None else ())
 
     def _answer(self, observation: Observation) -> Command:
         c, leg, tick = self.connected, observation.leg, self._tick(observation)

@@ -78,6 +78,8 @@ RESUME_AFTER_UNITS = 5.0
 
 EXPLORE, TRANSIT, RELAY, RETURN, RETREAT, RESERVE, RETIRED = (
     "explore", "transit", "relay", "return", "retreat", "reserve", "retired")
+#: Every mode, in a fixed order (a robot's ``mode`` telemetry is its index here).
+MODES = (EXPLORE, TRANSIT, RELAY, RETURN, RETREAT, RESERVE, RETIRED)
 
 
 class Leg(NamedTuple):

@@ -22,14 +22,30 @@ from mjswarm.worlds.graphworld import EDGE_TIMES
 
 
 def run_graph(args) -> dict:
-    """One run in the graph world; the JSON-ready result (see ``ExplorationResult``)."""
+    """One run in the graph world; the JSON-ready result (see ``ExplorationResult``).
+    With ``--record``, a recording on the time-unit timeline
+    (:class:`~mjswarm.outputs.exploration_recording.GraphExplorationRecording`)."""
     from mjswarm.experiments.runs import run_exploration
 
     spec = _spec(args)
-    result = run_exploration(spec, args.robots, args.strategy, world="graph", seed=args.seed,
-                             max_time=args.max_time, edge_time=args.edge_time or "unit",
-                             radio_range_m=args.radio_range, connectivity=args.connectivity)
-    return {"world": "graph", **result.to_dict()}
+    with ExitStack() as outputs:
+        functions = []
+        if args.record:
+            from mjswarm.outputs.exploration_recording import GraphExplorationRecording
+            from mjswarm.outputs.recording import Recorder
+
+            temp = outputs.enter_context(atomic_output(args.record, "recording"))
+            recorder = outputs.enter_context(Recorder(
+                temp, spec, args.robots, radio=args.radio_range is not None, sensors=False,
+                name=f"{spec.name}, {args.robots} robots, graph world", trail_window_s=5.0))
+            functions.append(GraphExplorationRecording(recorder, spec))
+        result = run_exploration(spec, args.robots, args.strategy, world="graph",
+                                 seed=args.seed, max_time=args.max_time,
+                                 edge_time=args.edge_time or "unit",
+                                 radio_range_m=args.radio_range,
+                                 connectivity=args.connectivity, functions=functions)
+    return {"world": "graph", **result.to_dict(),
+            **({"recording": args.record} if args.record else {})}
 
 
 def _spec(args):
@@ -222,9 +238,9 @@ def register(subparsers) -> None:
                           help="dynamic: MuJoCo's contact physics (default); kinematic: "
                                "robots move by their wheel kinematics and stop at contacts, "
                                "same scene and sensors, several times faster at large teams")
-    embodied.add_argument("--record", default=None, metavar="FILE.rrd",
-                          help="write a rerun recording of the run (open it with "
-                               "`mjswarm view FILE.rrd`)")
+    parser.add_argument("--record", default=None, metavar="FILE.rrd",
+                        help="write a rerun recording of the run, in any world (open it "
+                             "with `mjswarm view FILE.rrd`)")
     add_video_options(embodied)
     parser.add_argument("--json", default=None, metavar="PATH|-",
                         help="write the result as JSON to PATH, or to stdout with '-'")
@@ -238,8 +254,7 @@ EMBODIED_ONLY = {
     "stall_timeout": "--stall-timeout", "fault": "--fault",
     "line_noise": "--line-noise", "ir_noise": "--ir-noise", "wheel_slip": "--wheel-slip",
     "bearing_noise": "--bearing-noise",
-    "physics": "--physics",
-    "record": "--record", "video": "--video", "video_speed": "--video-speed",
+    "physics": "--physics", "video": "--video", "video_speed": "--video-speed",
 }
 
 
@@ -347,6 +362,8 @@ def summary(result: dict) -> str:
             f"{100 * result['biconnected_share']:.1f} %")
     if result["world"] == "embodied":
         lines += _embodied_lines(result)
+    elif result.get("recording"):
+        lines.append(f"recording: {result['recording']}")
     return "\n".join(lines)
 
 

@@ -91,10 +91,12 @@ def run_controllers(world: GraphWorld, controllers: Sequence[Controller], strate
     return loop.run()[0]
 
 
-def run_minds(world: GraphWorld, minds: list[Strategy], **options) -> ExplorationResult:
-    """Run each mind in its graph explorer (see :func:`run_controllers`)."""
-    return run_controllers(world, [graph_explorer(m) for m in minds], strategy_name(minds),
-                           **options)
+def run_minds(world: GraphWorld, minds: list[Strategy], *, report: bool = False,
+              **options) -> ExplorationResult:
+    """Run each mind in its graph explorer (see :func:`run_controllers`); with
+    ``report``, the robots report their vertex calls (for a recording)."""
+    return run_controllers(world, [graph_explorer(m, report) for m in minds],
+                           strategy_name(minds), **options)
 
 
 def explore_world(world: GraphWorld, n_robots: int,

@@ -182,10 +182,10 @@ class ConnectedExploration(LoopFunctions):
 
 
 def connected_controllers(minds: Sequence[Strategy], radio_range_m: float,
-                          connectivity: str) -> dict:
+                          connectivity: str, report: bool = False) -> dict:
     """The controllers of a run: a tethered explorer around each mind (robot 0 docked at
     the base under ``biconnected``, rule 1 of the tether) and, under a constraint, the
-    base station (``BASE``)."""
+    base station (``BASE``); with ``report`` the explorers report their vertex calls."""
     need, constrained = NEED.get(connectivity, 1), connectivity != "none"
     controllers = {BASE: FixedNode(BaseStation(Flooder()))} if constrained else {}
     for i, mind in enumerate(minds):
@@ -193,18 +193,21 @@ def connected_controllers(minds: Sequence[Strategy], radio_range_m: float,
             controllers[i] = FixedNode(docked(Flooder()))
             continue
         tether = Tether(i, radio_range_m, initial_parents(i, need), ticks_per_unit=TICKS_PER_UNIT)
-        controllers[i] = TetheredExplorer(ConnectedExplorer(i, mind, tether), constrained)
+        controllers[i] = TetheredExplorer(ConnectedExplorer(i, mind, tether), constrained,
+                                          report)
     return controllers
 
 
 def run_connected(world: GraphWorld, minds: list[Strategy], radio_range_m: float,
                   connectivity: str = "connected", *, seed: int | None = None,
                   max_time: float | None = None, arena: str = "<graph>",
-                  functions: Sequence[LoopFunctions] = ()) -> ConnectedExplorationResult:
+                  functions: Sequence[LoopFunctions] = (),
+                  report: bool = False) -> ConnectedExplorationResult:
     """Explore ``world``'s graph with ``minds`` (one per robot) from the root, with a
     radio of range ``radio_range_m`` (m), keeping ``connectivity`` (module docstring),
     until a declaration, rule 5's verdict or ``max_time`` time units (default: the graph
-    world's); ``functions`` are more loop functions (a recording)."""
+    world's); ``functions`` are more loop functions (a recording); with ``report`` the
+    robots report their vertex calls (for a recording)."""
     if connectivity not in CONNECTIVITY:
         raise MjswarmError(f"connectivity must be one of {', '.join(CONNECTIVITY)}, "
                            f"got '{connectivity}'")
@@ -213,7 +216,7 @@ def run_connected(world: GraphWorld, minds: list[Strategy], radio_range_m: float
     radio_world.reset(len(minds), base=connectivity != "none", dock=NEED.get(connectivity) == 2)
     experiment = ConnectedExploration(radio_world, strategy_name(minds), connectivity,
                                       seed=seed, arena=arena)
-    loop = Loop(radio_world, connected_controllers(minds, radio_range_m, connectivity),
+    loop = Loop(radio_world, connected_controllers(minds, radio_range_m, connectivity, report),
                 [experiment, *functions])
     max_time = default_max_time(world) if max_time is None else max_time
     return loop.run(max_ticks=2 * math.floor(max_time * TICKS_PER_UNIT))[0]

@@ -61,13 +61,16 @@ def run_exploration(spec: ArenaSpec, robots: int,
     minds = make_minds(strategy, robots, seed)
     from mjswarm.worlds.graphworld import GraphWorld
 
+    # loop functions that read the robots' VertexCalled reports (a recording) say so
+    report = any(getattr(f, "reads_vertex_calls", False) for f in functions)
     graph = GraphWorld(spec.graph(), spec.root, edge_time=edge_time)
     if radio_range_m is None:
         from mjswarm.experiments.graph_exploration import run_minds
 
         return run_minds(graph, minds, seed=seed, max_time=max_time, arena=spec.name,
-                         functions=functions)
+                         functions=functions, report=report)
     from mjswarm.experiments.radio_exploration import run_connected
 
     return run_connected(graph, minds, radio_range_m, connectivity or "none", seed=seed,
-                         max_time=max_time, arena=spec.name, functions=functions)
+                         max_time=max_time, arena=spec.name, functions=functions,
+                         report=report)

@@ -22,10 +22,17 @@ is right-handed, z up, the floor at z = 0)::
     robots/R<k>/sensors/encoders  Scalars per tick, 2 series: wheel angles (rad)
     robots/R<k>/battery       Scalars per tick: battery terminal voltage (V)
     robots/R<k>/bearings/R<j> Scalars (drawn as points) at ticks where R<k> sees R<j>
-    map/R<k>                  GraphNodes + GraphEdges: robot R<k>'s explored graph
+    robots/R<k>/state         Scalars per tick: the controller's telemetry, one series a name
+    states/R<k>/decision      StateChange: its decision at each vertex call (go, idle, done)
+    states/R<k>/mode          StateChange: its mode (a tethered robot's), when it changes
+    map/R<k>                  GraphNodes + GraphEdges: robot R<k>'s explored graph, in graph
+                              units (:attr:`Recorder.graph_scale` units per metre)
+    matrices/R<k>             TextDocument (markdown): the incidence matrix R<k> carries,
+                              after each of its vertex calls
     beacons/<vertex>          TextDocument: the beacon's contents (beacon-side vertex id)
-    radio/graph               GraphNodes + GraphEdges: who hears whom
+    radio/graph               GraphNodes + GraphEdges: who hears whom, in graph units
     radio/links               LineStrips3D: the same edges drawn between the robots
+    radio/tethers             LineStrips3D: each robot's link to its tether parent
     radio/truth               TextDocument: ground truth and the robots' beliefs
     events                    TextLog: run-wide events (launches of faults, completion, the end)
     events/R<k>               TextLog: robot R<k>'s events (vertex visits, speed changes, stops)
@@ -48,9 +55,13 @@ per tick. Choices:
   instead of a whole strip.
 * Bearings are sparse (a robot sees few others), so each observed pair gets its own
   series, drawn as points, sent only at the ticks of the observations.
-* Graph views (``map/*``, ``radio/graph``) use the positions given, with y negated:
-  rerun's graph view draws y downwards, so the graphs then look like the top view of
-  the arena.
+* Graph views (``map/*``, ``radio/graph``) use the positions given, with y negated and
+  scaled by :attr:`Recorder.graph_scale`: rerun's graph view draws y downwards, and
+  places nodes in its own units, where a node's label is some 30-60 units wide, so the
+  scale puts the closest two vertices of the arena :data:`GRAPH_SPACING` units apart
+  and every vertex's label stands apart from the others.
+* The arena view looks straight down on the arena (x to the right, y up), from a
+  height at which the arena fills the view.
 * An explored graph identical to the one last logged for that robot is not logged again.
 """
 
@@ -91,6 +102,11 @@ TRAIL_WINDOW_S = 30.0
 #: Above this many robots the blueprint shows all explored graphs in one graph view
 #: instead of one tab per robot.
 MAP_TAB_LIMIT = 8
+#: Graph-view units between the two closest vertices of the arena (a label is at most
+#: some 60 units wide).
+GRAPH_SPACING = 90.0
+#: Vertical field of view of rerun's 3-D view (degrees), for framing the arena.
+_FOV_Y_DEG = 55.0
 _TRAIL_Z_M = 0.004
 _VERTEX_Z_M = 0.006
 _STRIP_COLOR = (30, 30, 30, 255)
@@ -149,7 +165,7 @@ def open_viewer(path: str | Path) -> int:
     if not has_display():
         raise MjswarmError(
             f"no display (DISPLAY and WAYLAND_DISPLAY are unset), cannot open the viewer; "
-            f"copy {path} to a machine with a display and run `mjswarm view {path.name}`"
+            f"serve it to a browser with `mjswarm view {path} --web`"
         )
     return subprocess.call([*rerun_command(), str(path)])
 
@@ -229,6 +245,9 @@ class Recorder:
         if bounds_m is None:
             xy = np.array(list(arena.vertices.values()))
             bounds_m = (*xy.min(axis=0), *xy.max(axis=0))
+        #: graph-view units per metre (module docstring)
+        self.graph_scale = graph_scale(None if arena is None else arena.vertices.values(),
+                                       bounds_m)
         self.path = Path(path)
         self.sensors = sensors
         self.n_robots = n = int(n_robots)
@@ -248,7 +267,8 @@ class Recorder:
         self._stream.set_log_time_enabled(False)
         self._stream.send_recording_name(name or f"{arena.name}, {n} robots")
         self._stream.send_blueprint(_blueprint(bounds_m, n, trail_window_s, radio, sensors,
-                                               video))
+                                               video, self.graph_scale,
+                                               maps=arena is not None))
         self._closed = False
         self._buffers(self._chunk, n)
         self._log_static(arena, float(robot_radius_m))
@@ -271,6 +291,7 @@ class Recorder:
         self._trail_from: np.ndarray | None = None  # (n, 2): last position already sent
         self._latest_xy: np.ndarray | None = None  # (n, 2): last position logged
         self._last_map: dict[int, tuple] = {}
+        self._last_state: dict[tuple[int, str], str] = {}
         self._state: dict[tuple[int, str], tuple[list[int], list[float]]] = {}
 
     # --- static data -------------------------------------------------------------------
@@ -512,13 +533,31 @@ class Recorder:
             return
         self._last_map[robot] = key
         self._at(step, sim_time_s)
+        k = self.graph_scale
         ids = list(nodes)
         self._stream.log(
             f"map/{robot_name(robot)}",
-            rr.GraphNodes(ids, positions=[(x, -y) for x, y in nodes.values()], labels=ids,
-                          colors=robot_color(robot)),
+            rr.GraphNodes(ids, positions=[(k * x, -k * y) for x, y in nodes.values()],
+                          labels=ids, colors=robot_color(robot)),
             rr.GraphEdges(list(edges), graph_type="undirected"),
         )
+
+    def log_state(self, step: int, sim_time_s: float, robot: int, state: str,
+                  lane: str = "decision", changes_only: bool = False) -> None:
+        """Robot ``robot``'s controller enters ``state`` (a name) in ``lane``
+        (``states/R<k>/<lane>``); with ``changes_only``, nothing is logged while the
+        state stays the same."""
+        if changes_only and self._last_state.get((robot, lane)) == state:
+            return
+        self._last_state[(robot, lane)] = state
+        self._at(step, sim_time_s)
+        self._stream.log(f"states/{robot_name(robot)}/{lane}", rr.StateChange(state=state))
+
+    def log_matrix(self, step: int, sim_time_s: float, robot: int, markdown: str) -> None:
+        """The incidence matrix robot ``robot`` carries, as a markdown document."""
+        self._at(step, sim_time_s)
+        self._stream.log(f"matrices/{robot_name(robot)}",
+                         rr.TextDocument(markdown, media_type=rr.MediaType.MARKDOWN))
 
     def log_beacon(self, step: int, sim_time_s: float, vertex: str, text: str) -> None:
         """The contents of the beacon at ``vertex`` (the beacon's own id), as text."""
@@ -532,10 +571,17 @@ class Recorder:
         edges: Sequence[tuple[int, int]],
         beliefs: Mapping[int, str] | None = None,
         truth: str | Mapping[int, str] | None = None,
+        *,
+        fixed: Mapping[str, tuple[float, float]] | None = None,
+        fixed_links: Sequence[tuple[int, str]] = (),
+        tethers: Mapping[int, int] | None = None,
     ) -> None:
         """The radio graph (robot index pairs in range), drawn at the robots' positions.
 
-        With ``beliefs`` (robot -> its current answer, e.g. whether the team is
+        ``fixed``: radio nodes that are no robots (a base station), by name, at (x, y) (m),
+        and ``fixed_links`` the (robot, fixed node) pairs in range. ``tethers``: each
+        robot's tether parent (a robot index, or -1 for the first fixed node), drawn as
+        thick links over the arena. With ``beliefs`` (robot -> its current answer, e.g. whether the team is
         biconnected) and ``truth`` (the ground-truth answer: one for the team, or one per
         robot), nodes are green where the belief equals the truth, red where it differs,
         grey without a belief.
@@ -557,16 +603,29 @@ class Recorder:
                       else _AGREE_COLOR if beliefs[i] == truths.get(i) else _DISAGREE_COLOR
                       for i in range(n)]
         xy = self._positions()
+        fixed = dict(fixed or {})
+        k = self.graph_scale
+        node_xy = None if xy is None else [*(xy * (k, -k)), *((k * x, -k * y)
+                                                             for x, y in fixed.values())]
+        pairs = [(ids[a], ids[b]) for a, b in edges] + [(ids[a], f) for a, f in fixed_links]
         self._stream.log("radio/graph",
-                         rr.GraphNodes(ids, positions=None if xy is None else xy * (1.0, -1.0),
-                                       labels=labels, colors=colors),
-                         rr.GraphEdges([(ids[a], ids[b]) for a, b in edges],
-                                       graph_type="undirected"))
+                         rr.GraphNodes([*ids, *fixed], positions=node_xy,
+                                       labels=[*labels, *fixed],
+                                       colors=[*colors, *([_ROOT_COLOR] * len(fixed))]),
+                         rr.GraphEdges(pairs, graph_type="undirected"))
         if xy is not None:
             z = ROBOT_HEIGHT_M + 0.01
+            where = {ids[i]: xy[i] for i in range(n)} | {f: np.asarray(p) for f, p in fixed.items()}
             self._stream.log("radio/links", rr.LineStrips3D(
-                [[(*xy[a], z), (*xy[b], z)] for a, b in edges],
+                [[(*where[a], z), (*where[b], z)] for a, b in pairs],
                 colors=(60, 140, 255, 200), radii=0.003))
+            if tethers is not None:
+                first = next(iter(fixed), None)
+                ends = [(ids[i], ids[p] if p >= 0 else first) for i, p in tethers.items()
+                        if p >= 0 or first is not None]
+                self._stream.log("radio/tethers", rr.LineStrips3D(
+                    [[(*where[a], z + 0.005), (*where[b], z + 0.005)] for a, b in ends],
+                    colors=[robot_color(int(a[1:]) - 1) for a, _ in ends], radii=0.012))
         if truth is not None or beliefs:
             if isinstance(truth, Mapping):
                 lines = [f"{ids[i]}: {beliefs.get(i, '-')} (truth: {truth.get(i, '-')})"
@@ -623,48 +682,94 @@ class Recorder:
         self.close()
 
 
-def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
-               trail_window_s: float, radio: bool, sensors: bool,
-               video: bool = False) -> rrb.Blueprint:
-    """The layout the file opens with: 3-D scene + event log on the left; explored
-    graphs, beacons (and the radio graph) on the top right; time series (speeds,
-    controller state, and the sensors when recorded) on the bottom right."""
-    robots = [robot_name(i) for i in range(n_robots)]
+def graph_scale(vertices, bounds_m: tuple[float, float, float, float]) -> float:
+    """Graph-view units per metre: :data:`GRAPH_SPACING` units between the closest two of
+    ``vertices`` ((x, y) in m; None: a 20th of the larger side of ``bounds_m`` stands
+    for that distance)."""
+    xy = None if vertices is None else np.array(list(vertices), float).reshape(-1, 2)
+    if xy is not None and len(xy) > 1:
+        d = np.hypot(*(xy[:, None] - xy[None]).transpose(2, 0, 1))
+        closest = float(d[d > 1e-9].min()) if (d > 1e-9).any() else 1.0
+    else:
+        low, high = np.array(bounds_m[:2], float), np.array(bounds_m[2:], float)
+        closest = float(max((high - low).max(), 1.0)) / 20.0
+    return GRAPH_SPACING / closest
+
+
+def top_down_eye(bounds_m: tuple[float, float, float, float], aspect: float = 1.35,
+                 margin_m: float = 0.3) -> rrb.EyeControls3D:
+    """A camera straight above the middle of ``bounds_m`` (m), x to the right and y up,
+    high enough that the area and ``margin_m`` around it fill a view ``aspect`` times as
+    wide as it is tall (rerun's 3-D view sees :data:`_FOV_Y_DEG` degrees vertically)."""
     low, high = np.array(bounds_m[:2], float), np.array(bounds_m[2:], float)
     centre = (low + high) / 2.0
-    extent = float(max((high - low).max(), 1.0))
+    half_w, half_h = (high - low) / 2.0 + margin_m
+    height = max(half_h, half_w / aspect) / np.tan(np.radians(_FOV_Y_DEG) / 2.0)
+    return rrb.EyeControls3D(
+        position=(centre[0], centre[1], height), look_target=(centre[0], centre[1], 0.0),
+        eye_up=(0.0, 1.0, 0.0))
+
+
+def graph_bounds(bounds_m: tuple[float, float, float, float], scale: float,
+                 margin_m: float = 0.3) -> rrb.VisualBounds2D:
+    """What a graph view shows: ``bounds_m`` (m) and ``margin_m`` around them, in graph
+    units (``scale`` per metre, y negated as the graphs are logged)."""
+    x0, y0, x1, y1 = bounds_m
+    return rrb.VisualBounds2D(x_range=[scale * (x0 - margin_m), scale * (x1 + margin_m)],
+                              y_range=[-scale * (y1 + margin_m), -scale * (y0 - margin_m)])
+
+
+def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
+               trail_window_s: float, radio: bool, sensors: bool,
+               video: bool = False, scale: float = 1.0, maps: bool = True) -> rrb.Blueprint:
+    """The layout the file opens with, on the ``sim_time`` timeline, following the data
+    to its end: on the left the arena seen from above (strips, walls, named vertices,
+    robots in their colours with their headings and trails, radio links) over the event
+    log; on the right, one tab per robot with its explored graph over the incidence
+    matrix it carries (all graphs in one view above :data:`MAP_TAB_LIMIT` robots) and
+    the beacons, for runs on an arena (``maps``), and the radio graph, over the time series (controller state, speeds, and
+    the sensors when recorded). The blueprint, selection and time panels start
+    collapsed (the time panel to its one-line bar)."""
+    robots = [robot_name(i) for i in range(n_robots)]
     trail_range = rrb.VisibleTimeRanges(rrb.VisibleTimeRange(
         "sim_time",
         start=rrb.TimeRangeBoundary.cursor_relative(seconds=-trail_window_s),
         end=rrb.TimeRangeBoundary.cursor_relative(),
     ))
     scene = rrb.Spatial3DView(
-        name="arena",
+        name="arena (from above)",
         origin="/",
-        contents=["+ /arena/**", "+ /robots/**"] + (["+ /radio/links"] if radio else []),
+        contents=["+ /arena/**", "+ /robots/**"]
+        + (["+ /radio/links", "+ /radio/tethers"] if radio else []),
         overrides={f"/robots/{r}/trail": trail_range for r in robots},
-        eye_controls=rrb.EyeControls3D(
-            position=(centre[0], centre[1] - 0.8 * extent, 1.1 * extent),
-            look_target=(centre[0], centre[1], 0.0),
-            eye_up=(0.0, 0.0, 1.0),
-        ),
+        eye_controls=top_down_eye(bounds_m),
+        line_grid=rrb.LineGrid3D(visible=False),
     )
-    if n_robots <= MAP_TAB_LIMIT:
-        maps = [rrb.GraphView(name=f"map {r}", origin=f"/map/{r}") for r in robots]
+    frame = graph_bounds(bounds_m, scale)  # every graph in the arena's frame
+    if not maps:
+        maps = []
+    elif n_robots <= MAP_TAB_LIMIT:
+        maps = [rrb.Vertical(rrb.GraphView(name=f"map {r}", origin=f"/map/{r}",
+                                           visual_bounds=frame),
+                             rrb.TextDocumentView(name=f"incidence matrix {r}",
+                                                  origin=f"/matrices/{r}"),
+                             name=r, row_shares=[3, 2]) for r in robots]
     else:
-        maps = [rrb.GraphView(name="maps", origin="/map")]
-    radio_views = [rrb.GraphView(name="radio", origin="/radio/graph"),
+        maps = [rrb.GraphView(name="maps", origin="/map", visual_bounds=frame)]
+    radio_views = [rrb.GraphView(name="radio", origin="/radio/graph", visual_bounds=frame),
                    rrb.TextDocumentView(name="radio truth", origin="/radio/truth")]
-    graphs = rrb.Tabs(*maps, rrb.TextDocumentView(name="beacons", origin="/beacons"),
-                      *(radio_views if radio else []))
+    beacons = [rrb.TextDocumentView(name="beacons", origin="/beacons")] if maps else []
+    graphs = [*maps, *beacons, *(radio_views if radio else [])]
 
     def plot(name: str, leaf: str) -> rrb.TimeSeriesView:
         return rrb.TimeSeriesView(name=name, origin="/robots",
                                   contents=[f"+ /robots/{r}/{leaf}" for r in robots])
 
+    states = [rrb.StateTimelineView(name="controller state", origin="/states"),
+              plot("telemetry", "state/**")]
     series = rrb.Tabs(
+        *(states if maps else states[::-1]),
         plot("speed (m/s)", "speed"),
-        plot("controller state", "state/**"),
         *([plot("line sensors (m)", "sensors/line"),
            plot("IR (m)", "sensors/ir"),
            plot("bearings (rad)", "bearings/**"),
@@ -677,11 +782,12 @@ def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
         rrb.Horizontal(
             rrb.Vertical(scene, rrb.TextLogView(name="events", origin="/events"),
                          row_shares=[3, 1]),
-            rrb.Vertical(graphs, series),
-            column_shares=[3, 2],
+            rrb.Vertical(rrb.Tabs(*graphs), series, row_shares=[4, 1]) if graphs else series,
+            column_shares=[1, 1],
         ),
-        rrb.TimePanel(timeline="sim_time"),
-        collapse_panels=False,
+        rrb.BlueprintPanel(state="collapsed"),
+        rrb.SelectionPanel(state="collapsed"),
+        rrb.TimePanel(state="collapsed", timeline="sim_time", play_state="following"),
     )
 
 
