@@ -21,7 +21,7 @@ from mjswarm.outputs.recording import rerun_command
 from mjswarm.outputs.webview import free_port, port_open
 
 REPO = Path(__file__).resolve().parents[1]
-#: Seed 003's Fig. 9 run, vertex by vertex.
+#: Nagavarapu et al.'s Fig. 9 run, vertex by vertex.
 FIG9 = {"R1": ["v1", "v2", "v4", "v2", "v5", "v6", "v5", "v7", "v8"],
         "R2": ["v1", "v3", "v4", "v6", "v8", "v9", "v10", "v9", "v8"]}
 

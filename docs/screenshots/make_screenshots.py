@@ -1,7 +1,7 @@
 """Regenerate the screenshots of recordings in rerun's web viewer (docs/screenshots/*.png).
 
-Makes the recordings (the main job, ``mjswarm explore --arena arena2 --robots 4``; seed
-003's Fig. 9 in the graph world, plain and connected with a 1.5 m radio; a patrol in the
+Makes the recordings (the main job, ``mjswarm explore --arena arena2 --robots 4``;
+Nagavarapu et al.'s Fig. 9 in the graph world, plain and connected with a 1.5 m radio; a patrol in the
 point world), serves each with rerun's web viewer on 127.0.0.1, opens it in a headless
 Chromium (:mod:`mjswarm.outputs.webview`: needs ``apt-get install chromium
 chromium-driver`` and selenium) and saves the default layout as ``NAME.png``, and for the

@@ -8,7 +8,7 @@ truth (poses; in the embodied world the sensor record and bearings) and each rob
 telemetry; at each vertex call (the robots' typed
 :class:`~algorithms.exploration.events.VertexCalled` events) the beacon's contents, the
 robot's map (its beacon ids drawn at the arena vertices where they were first read), the
-incidence matrix it carries (a markdown table as seed 003 prints it: rows are vertices,
+incidence matrix it carries (a markdown table as Nagavarapu et al. print it: rows are vertices,
 columns edges, entries the incidence angles, negative for completed and out edges) and
 its decision as its state; the experiment's events (:meth:`~mjswarm.worlds.loop.Loop.event`)
 and contacts; and the radio graph: with connectivity tables, each robot's belief against
@@ -41,7 +41,7 @@ SAMPLES_PER_UNIT = 10
 
 
 def angle_text(theta: float) -> str:
-    """An incidence-matrix entry as seed 003 prints it: a multiple of pi (``-3π/2``)
+    """An incidence-matrix entry as Nagavarapu et al. print it: a multiple of pi (``-3π/2``)
     when it is one with a denominator up to 12; a measured angle within 0.05 rad of a
     multiple of pi/4 as that multiple after ``≈`` (an angle near 0 is near 2π: angles lie
     in (0, 2π]); else radians to two decimals."""
@@ -127,7 +127,7 @@ class ArenaNames:
 def matrix_markdown(matrix, names: ArenaNames, title: str) -> str:
     """``matrix`` (an :class:`~algorithms.exploration.incidence_matrix.IncidenceMatrix`)
     as a markdown table under ``title``: a row per known vertex, a column per edge in
-    Algorithm 2's order (completed, out, unexplored), the entries as seed 003 prints them."""
+    Algorithm 2's order (completed, out, unexplored), the entries as Nagavarapu et al. print them."""
     if matrix is None:
         return f"**{title}**\n\n(no incidence matrix)"
     tags, columns, dense = matrix.to_array()

@@ -1,4 +1,4 @@
-"""Rerun recordings of runs, written headless to an ``.rrd`` file (issue 5, part 4).
+"""Rerun recordings of runs, written headless to an ``.rrd`` file.
 
 A :class:`Recorder` writes one rerun (0.41) recording: the arena as static data, every
 robot's pose, trail and sensor readings per control tick, and the rarer things (events,

@@ -1,4 +1,4 @@
-"""Video of any run, rendered offscreen as the loop runs (issue 15).
+"""Video of any run, rendered offscreen as the loop runs.
 
 A :class:`Video` loop function draws a frame whenever the simulated time reaches the next
 frame's (one every ``speedup / fps`` simulated seconds: ``fps`` frames per second of video,
