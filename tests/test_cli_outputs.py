@@ -83,7 +83,7 @@ def test_json_to_a_bad_path_fails_before_simulating(tmp_path, capsys, monkeypatc
 
 
 @pytest.mark.parametrize("option", [
-    ["--record", "x.rrd"], ["--speed", "0.1"], ["--launch-interval", "3"],
+    ["--speed", "0.1"], ["--launch-interval", "3"],
     ["--launch-order", "2,1"], ["--no-collision-avoidance"],
     ["--fault", "robot:1@3"], ["--wheel-slip", "0.01"], ["--physics", "kinematic"],
 ])
