@@ -180,6 +180,7 @@ class Controller(ABC):
     def step(self, observation: Observation) -> Command:
         """Answer one tick's observation with a command."""
 
-    def telemetry(self) -> Mapping[str, float]:
-        """Named numbers that describe its state now, for recordings (none by default)."""
+    def telemetry(self) -> Mapping[str, float | str]:
+        """What describes its state now, for recordings (none by default): named numbers
+        (drawn as time series) and named states (strings, drawn as state lanes)."""
         return NOTHING

@@ -223,7 +223,7 @@ def test_a_sealed_controller_refuses_its_attributes():
     from algorithms.maintenance.roles import Role, RoleParams, RoleSwitchingRobot
 
     robot = Sealed(RoleSwitchingRobot(1, Role.EXPLORER, RoleParams()))
-    assert robot.telemetry()["role"] == list(Role).index(Role.EXPLORER)
+    assert robot.telemetry()["role"] == Role.EXPLORER.value
     with pytest.raises(AssertionError, match="read the controller's 'role'"):
         robot.role
     with pytest.raises(AssertionError, match="wrote the controller's 'target'"):

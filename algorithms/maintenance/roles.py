@@ -267,11 +267,11 @@ class RoleSwitchingRobot(Controller):
                        messages=tuple(Message(payload, to) for to, payload in out),
                        signal=self.role, events=tuple(self._events))
 
-    def telemetry(self) -> dict[str, float]:
-        """Its role (0 base station, 1 repeater, 2 local leader, 3 explorer, the order of
-        :class:`Role`), the number of robots it is connected to (|A_i|) and the AAT's
-        cost so far: angle and circle tests, and the wall time they took (s)."""
-        return {"role": list(Role).index(self.role), "connections": len(self.connections),
+    def telemetry(self) -> dict[str, float | str]:
+        """Its role (the :class:`Role`'s name), the number of robots it is connected to
+        (|A_i|) and the AAT's cost so far: angle and circle tests, and the wall time they
+        took (s)."""
+        return {"role": self.role.value, "connections": len(self.connections),
                 "angle_tests": self.angle_tests, "circle_tests": self.circle_tests,
                 "aat_s": self.aat_seconds}
 

@@ -794,7 +794,8 @@ def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
 class Recording(LoopFunctions):
     """Records any run of the one loop (:class:`~mjswarm.worlds.loop.Loop`) with ``recorder``:
     every robot's pose, trail and commanded speed per tick, each controller's
-    :meth:`~algorithms.robot.Controller.telemetry` as time series, and the radio graph
+    :meth:`~algorithms.robot.Controller.telemetry` (numbers as time series, named states
+    such as a role as state lanes ``states/R<k>/<name>``), and the radio graph
     every ``radio_every`` ticks when the world has a radio. Robots off the floor are
     drawn where the world keeps them (the depot). Close the recorder after the run."""
 
@@ -807,7 +808,14 @@ class Recording(LoopFunctions):
         world, rec = loop.world, self.recorder
         step, now = loop.ticks, world.time_s
         poses = world.true_poses()
-        state = {i: c.telemetry() for i, c in loop.controllers.items() if world.present[i]}
+        state = {}
+        for i, c in loop.controllers.items():
+            if world.present[i]:
+                telemetry = c.telemetry()
+                state[i] = {k: v for k, v in telemetry.items() if not isinstance(v, str)}
+                for lane, name in telemetry.items():
+                    if isinstance(name, str):
+                        rec.log_state(step, now, i, name, lane=lane, changes_only=True)
         rec.log_tick(step, now, poses, speed=world.commanded_speeds(), state=state)
         events = world.contact_events() or []
         for _, i, j in events[self._contacts:]:
