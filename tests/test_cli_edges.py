@@ -14,6 +14,7 @@ from pathlib import Path
 
 import mujoco
 import pytest
+from test_outputs_trust import interrupt_after
 
 import mjswarm.experiments.exploration
 from mjswarm.cli import build_parser, main
@@ -113,23 +114,9 @@ def test_exported_robots_stand_apart_in_the_depot(tmp_path, capsys):
 # ------------------------------------------------------------------ interruptions
 
 
-def _interrupt_at_tick(monkeypatch, ticks: int) -> None:
-    step = mjswarm.experiments.exploration.EmbodiedExploration.ticked
-    calls = {"n": 0}
-
-    def step_then_interrupt(self, *args):
-        calls["n"] += 1
-        if calls["n"] == ticks:
-            raise KeyboardInterrupt
-        step(self, *args)
-
-    monkeypatch.setattr(mjswarm.experiments.exploration.EmbodiedExploration, "ticked",
-                        step_then_interrupt)
-
-
 def test_the_summary_and_json_name_the_partial_actually_written(tmp_path, capsys,
                                                                 monkeypatch):
-    _interrupt_at_tick(monkeypatch, 20)
+    interrupt_after(monkeypatch, 20)
     record = tmp_path / "run.rrd"
     record.write_bytes(b"an earlier recording")
     assert main(["explore", "--arena", "arena1", "--robots", "1", "--record", str(record),
@@ -137,7 +124,7 @@ def test_the_summary_and_json_name_the_partial_actually_written(tmp_path, capsys
     partial = str(tmp_path / "run.partial.rrd")
     result = json.loads(capsys.readouterr().out)
     assert result["recording"] == partial and result["ended_because"] == "interrupted"
-    _interrupt_at_tick(monkeypatch, 20)
+    interrupt_after(monkeypatch, 20)
     assert main(["explore", "--arena", "arena1", "--robots", "1", "--record", str(record)]) \
         == 130
     assert f"recording: {tmp_path / 'run.partial-2.rrd'}" in capsys.readouterr().out
@@ -180,13 +167,18 @@ def test_sigterm_ends_a_run_as_ctrl_c_does(tmp_path):
 
 
 def test_plot_of_a_truncated_recording_prints_only_its_error(tmp_path, capsys):
+    """In a process of its own: pytest would catch the reader's warnings."""
     record = tmp_path / "run.rrd"
     assert main(["explore", "--arena", "arena1", "--robots", "1", "--max-time", "1",
                  "--record", str(record)]) == 1
     record.write_bytes(record.read_bytes()[: record.stat().st_size // 2])
-    capsys.readouterr()
-    err = one_line_error(capsys, ["plot", str(record), "-o", str(tmp_path / "run.png")])
-    assert "cannot read recording" in err
+    done = subprocess.run([sys.executable, "-m", "mjswarm.cli", "plot", str(record), "-o",
+                           str(tmp_path / "run.png")], capture_output=True, text=True,
+                          env={**os.environ, "PYTHONPATH": str(REPO)}, timeout=120,
+                          check=False)
+    err = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(err) == 1, done.stderr
+    assert err[0].startswith("mjswarm: error: cannot read recording")
 
 
 # ------------------------------------------------------------------ help
