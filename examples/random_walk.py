@@ -15,6 +15,7 @@ unless ``--out`` names another (a relative one is taken from the current directo
 import argparse
 import math
 import random
+import sys
 from pathlib import Path
 
 from algorithms.robot import Command, Controller, Observation
@@ -56,6 +57,9 @@ parser.add_argument("--seconds", type=float, default=60.0, help="simulated time 
 parser.add_argument("--out", default=str(Path(__file__).resolve().parents[1] / "recordings"),
                     help="folder for the .rrd files (default: recordings/ in the repository)")
 args = parser.parse_args()
+if not Path(args.out).is_dir():  # one line, as mjswarm's own refusals
+    print(f"random_walk.py: error: --out {args.out} is not a directory", file=sys.stderr)
+    sys.exit(2)
 
 starts = spread(args.robots, radius_m=1.0, seed=1)
 for name, World in (("point", PointWorld), ("mujoco", EmbodiedFloor)):

@@ -46,4 +46,4 @@ def test_recording_shows_radio_graph_and_beliefs(tmp_path, capsys):
 
 def test_radio_range_must_be_positive(capsys):
     assert main(["explore", "--arena", "fig9", "--robots", "2", "--radio-range", "0"]) == 2
-    assert "radio range must be positive" in capsys.readouterr().err
+    assert "--radio-range must be a finite number > 0" in capsys.readouterr().err

@@ -94,10 +94,10 @@ def test_embodied_options_with_the_graph_world_are_errors(capsys, option):
 
 
 @pytest.mark.parametrize("argv,message", [
-    (["--max-time", "-5"], "--max-time must be positive"),
-    (["--max-time", "0"], "--max-time must be positive"),
+    (["--max-time", "-5"], "--max-time must be a finite number > 0"),
+    (["--max-time", "0"], "--max-time must be a finite number > 0"),
     (["--launch-interval", "-1"], "--launch-interval must be a finite number >= 0"),
-    (["--edge-time", "length"], "--edge-time only applies to the graph world"),
+    (["--edge-time", "length"], "--edge-time applies only to the graph world"),
 ])
 def test_impossible_values_are_errors(capsys, argv, message):
     assert message in one_line_error(capsys, ["explore", "--arena", "fig9", "--robots", "2",

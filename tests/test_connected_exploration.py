@@ -284,7 +284,7 @@ def test_cli_reports_the_constraint(tmp_path, capsys):
 
 @pytest.mark.parametrize("argv,message", [
     (["--connectivity", "connected", "--world", "graph"], "needs --radio-range"),
-    (["--radio-range", "-1", "--world", "graph"], "radio range must be positive"),
+    (["--radio-range", "-1", "--world", "graph"], "--radio-range must be a finite number > 0"),
     (["--radio-range", "3", "--connectivity", "biconnected", "--robots", "1"],
      "needs at least 2 robots"),
 ])

@@ -120,8 +120,8 @@ def test_cli_reports_the_cap(tmp_path, capsys):
     ("extra", "words"),
     [
         (["--method", "flood"], "unknown method 'flood'"),
-        (["--method", "tables", "--range", "0"], "positive"),
-        (["--method", "tables", "--range", "-2"], "positive"),
+        (["--method", "tables", "--range", "0"], "--range must be a finite number > 0"),
+        (["--method", "tables", "--range", "-2"], "--range must be a finite number > 0"),
         (["--method", "tables"], "range is needed"),
         (["--method", "tables", "--range", "1", "--initiator", "zz"], "initiator 'zz'"),
         (["--method", "stamps", "--range", "1", "--max-robots", "2"], "below the team size"),

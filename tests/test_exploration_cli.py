@@ -50,7 +50,7 @@ def test_explore_root_and_edge_time_options(capsys):
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["--robots", "0"], "at least one robot"),
+    (["--robots", "0"], "--robots must be a whole number >= 1"),
     (["--robots", "2", "--strategy", "teleport"], "unknown strategy 'teleport'"),
     (["--robots", "2", "--arena", "atlantis"], "unknown arena 'atlantis'"),
     (["--robots", "2", "--root", "v99"], "root 'v99'"),

@@ -54,15 +54,12 @@ def arena_world_spec(
     return world
 
 
-def export_mjcf(spec: ArenaSpec, out: str | Path, robots: int = 0) -> Path:
-    """Write a standalone MJCF of the arena (with ``robots`` robots at the root) to ``out``.
+def export_mjcf(spec: ArenaSpec, out: str | Path, poses: Sequence[Pose2D] = ()) -> Path:
+    """Write a standalone MJCF of the arena, with robots at ``poses``, to ``out``.
 
     Nothing is written if the world does not compile.
     """
-    if robots < 0:
-        raise MjswarmError(f"robot count must be >= 0, got {robots}")
-    root = spec.vertices[spec.root]
-    world = arena_world_spec(spec, [Pose2D(root[0], root[1], 0.0)] * robots)
+    world = arena_world_spec(spec, poses)
     try:
         with quiet_empty_prefix():
             world.compile()

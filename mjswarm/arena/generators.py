@@ -67,7 +67,6 @@ import re
 
 import networkx as nx
 import numpy as np
-from scipy.spatial import Delaunay
 
 from mjswarm.arena import geometry
 
@@ -372,6 +371,8 @@ def _pruned_delaunay(text: str, n: int, seed: int, rng: np.random.Generator):
         if all(np.linalg.norm(p - q) >= gap for q in points):
             points.append(p)
     pts = np.round(np.array(points) - points[0], 4)
+    from scipy.spatial import Delaunay  # heavy: imported when first needed
+
     triangles = Delaunay(pts).simplices
     pairs = sorted({tuple(sorted((int(a), int(b)))) for t in triangles
                     for a, b in ((t[0], t[1]), (t[1], t[2]), (t[0], t[2]))})

@@ -7,7 +7,9 @@ anything :func:`mjswarm.arena.load_arena` accepts.
 from __future__ import annotations
 
 from mjswarm.arena import load_arena, shipped_arenas
-from mjswarm.cli.output import write_json
+from mjswarm.cli.numbers import whole
+from mjswarm.cli.output import atomic_output, check_writable, write_json
+from mjswarm.experiments.minds import MAX_ROBOTS
 
 _ARENA_HELP = (
     "a shipped arena ({shipped}), a .json/.toml spec file, or a generator: "
@@ -83,19 +85,29 @@ def _register_export(actions) -> None:
         help="write an arena as a standalone MJCF file",
         description="Build the arena's MuJoCo world (floor, lane strips, vertex spokes, "
         "corridor walls, a site per vertex) and write it as MJCF that loads in plain "
-        "MuJoCo. Nothing is written if the arena is invalid.",
+        "MuJoCo: the scene an embodied exploration starts from. Nothing is written if the "
+        "arena is invalid.",
     )
     add_arena_argument(parser)
     parser.add_argument("out", metavar="OUT.xml", help="the MJCF file to write")
-    parser.add_argument("--robots", type=int, default=0, metavar="K",
-                        help="also place K robots at the root vertex (default: 0)")
+    parser.add_argument("--robots", action=whole(least=0, most=MAX_ROBOTS,
+                                                 why="the largest team any run takes"),
+                        default=0, metavar="K",
+                        help="also place K robots in the depot, the row below the arena where "
+                             "an embodied exploration's robots wait for their launch "
+                             f"(default: 0; at most {MAX_ROBOTS})")
     parser.set_defaults(func=export)
 
 
 def export(args) -> int:
-    """``mjswarm arena export``: write the arena's MJCF."""
+    """``mjswarm arena export``: write the arena's MJCF, with the robots where an embodied
+    exploration puts them before its first launch."""
     from mjswarm.arena.builder import export_mjcf
+    from mjswarm.experiments.launching import depot
 
-    out = export_mjcf(load_arena(args.arena), args.out, robots=args.robots)
-    print(f"wrote {out}")
+    check_writable(args.out, "MJCF")
+    spec = load_arena(args.arena)
+    with atomic_output(args.out, "MJCF") as temp:
+        export_mjcf(spec, temp, depot(spec, args.robots))
+    print(f"wrote {args.out}")
     return 0

@@ -8,17 +8,28 @@ import sys
 
 from tqdm import tqdm
 
-from mjswarm.core.kinematic import PHYSICS
+from mjswarm.cli.numbers import number
+from mjswarm.core import PHYSICS
 from mjswarm.errors import MjswarmError
 
 
+#: Longest measurement (simulated s): a rate settles within seconds; the default is 2.
+MAX_SECONDS = 3600.0
+
+
 def _counts(text: str) -> list[int]:
+    """``--robots``: robot counts from 1 to the largest team any run takes."""
+    from mjswarm.experiments.minds import MAX_ROBOTS
+
     try:
         counts = [int(part) for part in text.split(",") if part.strip()]
     except ValueError:
         raise MjswarmError(f"--robots takes comma-separated whole numbers, got '{text}'") from None
     if not counts or min(counts) < 1:
         raise MjswarmError(f"--robots needs counts >= 1, got '{text}'")
+    if max(counts) > MAX_ROBOTS:
+        raise MjswarmError(f"--robots takes counts up to {MAX_ROBOTS} (the largest team any "
+                           f"run takes), got {max(counts)}")
     return counts
 
 
@@ -29,14 +40,16 @@ def register(subparsers) -> None:
         description=(
             "Drive N robots on a floor with strips and walls, each with every sensor (line, IR, "
             "encoders, bearing sensor), a radio (1 m, line of sight, a heartbeat per tick) and "
-            "the seed-003 speed rule over a line follower, and report simulated seconds per "
+            "Nagavarapu et al.'s bearing-rate speed rule over a line follower, and report simulated seconds per "
             "wall second for this full loop and for bare mj_step on the same world, and their "
             "ratio (overhead_ratio = full wall time / bare wall time)."
         ),
     )
     parser.add_argument("--robots", default="1,10,100,300", metavar="N,N,...",
                         help="robot counts to measure (default: 1,10,100,300)")
-    parser.add_argument("--seconds", type=float, default=2.0, metavar="S",
+    parser.add_argument("--seconds", action=number(above=0, most=MAX_SECONDS,
+                                                  why="a rate settles within seconds"),
+                        default=2.0, metavar="S",
                         help="simulated seconds per measurement (default: 2.0)")
     parser.add_argument("--model", default=None, metavar="MJCF",
                         help="robot model file (default: models/spark_v.xml)")

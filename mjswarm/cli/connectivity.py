@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import argparse
 
+from mjswarm.cli.numbers import number, whole
 from mjswarm.cli.output import check_writable, write_json
-from mjswarm.experiments.connectivity import DEFAULT_MESSAGE_CAP, METHODS, load_team, run_check
+from mjswarm.core.radio import MAX_RANGE_M
+from mjswarm.experiments.connectivity import DEFAULT_MESSAGE_CAP, METHODS
 
 
 def register(subparsers) -> None:
@@ -15,8 +17,8 @@ def register(subparsers) -> None:
         description=(
             "Run one connectivity-awareness method on robots at fixed positions, message by "
             "message over the radio (one tick per hop), and report its verdicts and costs. "
-            "stamps: Ahmadi & Stone's stamped-message check (seed 002); tables: Le et al.'s "
-            "connectivity tables (seed 004); tables-2: their forward-two variant."
+            "stamps: Ahmadi & Stone's stamped-message check; tables: Le et al.'s "
+            "connectivity tables; tables-2: their forward-two variant."
         ),
         epilog=(
             'FILE is JSON: {"positions": {"id": [x, y], ...}} in metres, optionally with '
@@ -26,7 +28,8 @@ def register(subparsers) -> None:
     )
     parser.add_argument("--positions", required=True, metavar="FILE", help="team file (JSON)")
     parser.add_argument(
-        "--range", type=float, dest="range_m", metavar="R",
+        "--range", dest="range_m", metavar="R",
+        action=number(above=0, most=MAX_RANGE_M, why="m; a longer range reaches no further"),
         help="radio range d_c in metres (required unless FILE has edges)",
     )
     parser.add_argument(
@@ -39,16 +42,17 @@ def register(subparsers) -> None:
         "default: the file's first robot",
     )
     parser.add_argument(
-        "--max-robots", type=int, metavar="N",
+        "--max-robots", action=whole(), metavar="N",
         help="N, the known maximum team size that sets the waits (default: team size)",
     )
     parser.add_argument(
-        "--drop-prob", type=float, default=0.0, metavar="P",
+        "--drop-prob", action=number(least=0), default=0.0, metavar="P",
         help="probability that a radio copy is lost (default 0, as the papers assume)",
     )
-    parser.add_argument("--seed", type=int, default=0, help="seed for radio drops (default 0)")
+    parser.add_argument("--seed", action=whole(least=0), default=0,
+                        help="seed for radio drops (default 0)")
     parser.add_argument(
-        "--message-cap", type=int, default=DEFAULT_MESSAGE_CAP, metavar="M",
+        "--message-cap", action=whole(), default=DEFAULT_MESSAGE_CAP, metavar="M",
         help=f"stop after M messages and report unknown verdicts (default {DEFAULT_MESSAGE_CAP})",
     )
     parser.add_argument(
@@ -62,6 +66,8 @@ def _yes_no(value: bool | None) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from mjswarm.experiments.connectivity import load_team, run_check
+
     check_writable(args.json, "JSON")  # before any work, not after it
     team = load_team(args.positions)
     result = run_check(

@@ -1,4 +1,4 @@
-"""``mjswarm experiment biconnected-coverage``: seed 002's S-coverage experiment."""
+"""``mjswarm experiment biconnected-coverage``: Ahmadi & Stone's S-coverage experiment."""
 
 from __future__ import annotations
 
@@ -10,16 +10,17 @@ from contextlib import ExitStack
 from tqdm import tqdm
 
 from algorithms.maintenance.biconnected import PLACEMENTS
+from mjswarm.cli.numbers import number, whole
 from mjswarm.cli.output import check_outputs, check_writable, write_json
 from mjswarm.cli.video_options import add_video_options, check_video
 from mjswarm.cli.watch import watchers
-from mjswarm.experiments.coverage import MAX_ROBOTS, WORLDS, area, run_coverage
+from mjswarm.experiments.coverage import MAX_REGION_DIAMETER_M, WORLDS
 
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "biconnected-coverage",
-        help="seed 002: S-coverage of a biconnected team under random add / remove",
+        help="Ahmadi & Stone: S-coverage of a biconnected team under random add / remove",
         description=(
             "Ahmadi & Stone's experiment: robots hold circular regions of one diameter D "
             "and stay biconnected while, each episode, a random robot is removed or added "
@@ -35,24 +36,28 @@ def register(subparsers) -> None:
     parser.add_argument("--placement", choices=PLACEMENTS, default="heuristic",
                         help="where an added robot goes: the paper's max-distance heuristic "
                              "(default) or the region of minimum intersection")
-    parser.add_argument("--episodes", type=int, default=100,
+    parser.add_argument("--episodes", action=whole(), default=100,
                         help="random add / remove episodes (default 100)")
-    parser.add_argument("--seed", type=int, default=0, help="seed (default 0)")
+    parser.add_argument("--seed", action=whole(least=0), default=0, help="seed (default 0)")
     parser.add_argument("--world", choices=WORLDS, default="embodied",
                         help="embodied MuJoCo robots (default) or kinematic points (faster)")
-    parser.add_argument("--region-diameter", type=float, default=1.0, metavar="M",
-                        help="region diameter D in metres (default 1.0)")
+    parser.add_argument("--region-diameter", default=1.0, metavar="M",
+                        action=number(above=0.2, most=MAX_REGION_DIAMETER_M,
+                                      why="m; the embodied floor reaches up to 90 D from the origin"),
+                        help="region diameter D in metres, more than a robot's 0.15 m "
+                             f"(default 1.0; at most {MAX_REGION_DIAMETER_M:g})")
     parser.add_argument("--json", metavar="PATH",
                         help="write the result as JSON to PATH ('-' for stdout only)")
     parser.add_argument("--record", metavar="FILE.rrd",
                         help="write a rerun recording of the run: poses and trails, each "
-                             "robot's controller state, the radio graph, events"
-)
+                             "robot's controller state, the radio graph, events")
     add_video_options(parser)
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    from mjswarm.experiments.coverage import MAX_ROBOTS, area, run_coverage
+
     check_writable(args.json, "JSON")  # before any work, not after it
     check_writable(args.record, "recording")
     check_outputs({"--record": args.record, "--video": args.video, "--json": args.json},

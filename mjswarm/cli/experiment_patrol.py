@@ -1,4 +1,4 @@
-"""``mjswarm experiment patrol``: seed 001's patrol mission with role switching."""
+"""``mjswarm experiment patrol``: Kobayashi et al.'s patrol mission with role switching."""
 
 from __future__ import annotations
 
@@ -8,17 +8,18 @@ from contextlib import ExitStack
 
 from tqdm import tqdm
 
+from mjswarm.cli.numbers import whole
 from mjswarm.cli.output import check_outputs, check_writable, write_json
 from mjswarm.cli.video_options import add_video_options, check_video
 from mjswarm.cli.watch import watchers
 from mjswarm.errors import MjswarmError
-from mjswarm.experiments.patrol import STEP_S, WORLDS, area, run_patrol
+from mjswarm.experiments.patrol import MAX_ROBOTS, MIN_ROBOTS, STEP_S, WORLDS
 
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "patrol",
-        help="seed 001: patrol mission keeping the swarm connected to a base station",
+        help="Kobayashi et al.: patrol mission keeping the swarm connected to a base station",
         description=(
             "Kobayashi, Higuchi & Ueno's patrol: a base station at the origin, a local "
             "leader led to random targets in [0, 1.8 sqrt(N)]^2 m, explorers flocking "
@@ -32,12 +33,16 @@ def register(subparsers) -> None:
             "fast kinematic world."
         ),
     )
-    parser.add_argument("--robots", type=int, default=10,
-                        help="swarm size N including the base station (default 10)")
-    parser.add_argument("--trials", type=int, default=1,
+    parser.add_argument("--robots", default=10, metavar="N",
+                        action=whole(least=MIN_ROBOTS, most=MAX_ROBOTS,
+                                     why="a step's cost grows as N squared"),
+                        help=f"swarm size N including the base station, {MIN_ROBOTS} to "
+                             f"{MAX_ROBOTS} (default 10)")
+    parser.add_argument("--trials", action=whole(), default=1,
                         help="missions, seeds S..S+T-1 (default 1; the paper ran 30)")
-    parser.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
-    parser.add_argument("--steps", type=int, default=2000,
+    parser.add_argument("--seed", action=whole(least=0), default=0,
+                        help="first seed (default 0)")
+    parser.add_argument("--steps", action=whole(), default=2000,
                         help=f"timesteps per mission, {STEP_S} s each (default 2000)")
     parser.add_argument("--world", choices=WORLDS, default="embodied",
                         help="embodied MuJoCo robots (default) or kinematic points (faster)")
@@ -55,13 +60,13 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from mjswarm.experiments.patrol import area, run_patrol
+
     check_writable(args.json, "JSON")  # before any work, not after it
     check_writable(args.record, "recording")
     check_outputs({"--record": args.record, "--video": args.video, "--json": args.json},
                   {"--record": ".rrd"})
     speedup = check_video(args)
-    if args.steps < 1:
-        raise MjswarmError(f"need at least one step, got {args.steps}")
     if (args.record or args.video) and args.trials != 1:
         raise MjswarmError(f"--record and --video hold one mission; drop --trials {args.trials}")
     with ExitStack() as outputs:

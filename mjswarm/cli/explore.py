@@ -1,4 +1,4 @@
-"""``mjswarm explore``: run one exploration and report seed 003's metrics.
+"""``mjswarm explore``: run one exploration and report Nagavarapu et al.'s metrics.
 
 Worlds: ``embodied`` (MuJoCo robots with their own sensors, :mod:`mjswarm.experiments.exploration`; the
 default) and ``graph`` (the fast abstract graph world, :mod:`mjswarm.worlds.graphworld`). Each
@@ -7,15 +7,22 @@ world is a function ``run_<world>(args) -> dict`` registered in :data:`WORLDS`.
 
 from __future__ import annotations
 
-import math
 from contextlib import ExitStack
 
 from algorithms.collision import PAPER_SPEED_M_S
 from algorithms.exploration import STRATEGIES
-from mjswarm.cli.output import atomic_output, check_outputs, check_writable, write_json
+from mjswarm.cli.numbers import number, whole
+from mjswarm.cli.output import (
+    atomic_output,
+    check_outputs,
+    check_writable,
+    drop_if_useless,
+    interrupted_outputs,
+    write_json,
+)
 from mjswarm.cli.video_options import add_video_options, check_video
-from mjswarm.core.kinematic import PHYSICS
-from mjswarm.core.robot import spark_v_geometry
+from mjswarm.core import PHYSICS
+from mjswarm.core.radio import MAX_RANGE_M
 from mjswarm.errors import MjswarmError, RunInterrupted
 from mjswarm.experiments.radio_exploration import CONNECTIVITY
 from mjswarm.worlds.graphworld import EDGE_TIMES
@@ -89,9 +96,10 @@ def run_embodied(args) -> dict:
         recorder = video = None
         if args.record:
             temp = outputs.enter_context(atomic_output(args.record, "recording"))
-            recorder = outputs.enter_context(Recorder(
-                temp, spec, args.robots, radio=args.radio_range is not None,
-                video=args.video is not None))
+            recorder = Recorder(temp, spec, args.robots, radio=args.radio_range is not None,
+                                video=args.video is not None)
+            outputs.push(drop_if_useless(temp, lambda: recorder.ticks > 0))
+            outputs.enter_context(recorder)
         recording = None if recorder is None else ExplorationRecording(recorder, spec, truth)
         if args.video:
             video = Video(outputs.enter_context(atomic_output(args.video, "video")),
@@ -149,7 +157,8 @@ def register(subparsers) -> None:
         help="explore an arena with K robots and report makespan, traversals and the map",
         description=(
             "Explore an arena from its root with K robots running one strategy and report "
-            "seed 003's metrics: makespan (time steps until a robot declares completion; "
+            "the metrics of Nagavarapu, Vachhani & Sinha's incidence-matrix exploration: "
+            "makespan (time steps until a robot declares completion; "
             "with unit edge time, the paper's number of edge traversals), total and "
             "per-robot traversals, who declared where, and the declaring robot's map; "
             "embodied runs add collisions, speed changes and simulated/wall time. "
@@ -165,18 +174,19 @@ def register(subparsers) -> None:
                              "random-tree:E:SEED, random-graph:V:E:SEED, fan:N:DEG, wheel:N, "
                              "hex:RxC, tri:RxC, random-planar:V:SEED); append @DEG to rotate "
                              "it about its root")
-    parser.add_argument("--robots", type=int, required=True, metavar="K",
+    parser.add_argument("--robots", action=whole(), required=True, metavar="K",
                         help="number of robots, all starting at the root")
     parser.add_argument("--strategy", default="incidence-dfs", metavar="NAME",
                         help=f"one of {', '.join(STRATEGIES)} (default: incidence-dfs, "
-                             "seed 003's method)")
+                             "Nagavarapu et al.'s incidence-matrix method)")
     parser.add_argument("--root", default=None, metavar="VERTEX",
                         help="start vertex (default: the arena's root)")
-    parser.add_argument("--seed", type=int, default=None, metavar="S",
+    parser.add_argument("--seed", action=whole(least=0), default=None, metavar="S",
                         help="randomise tie-breaking with this seed (default: the "
                              "strategies' fixed tie rules)")
     parser.add_argument("--connectivity", default=None, choices=CONNECTIVITY,
-                        help="none: explore as seed 003 (default); connected: every robot "
+                        help="none: explore as Nagavarapu et al. do, unconstrained "
+                             "(default); connected: every robot "
                              "keeps a radio route to the base at the root; biconnected: two "
                              "disjoint routes, so that one robot failing cuts nobody off "
                              "(the first robot docks at the base as its partner and does "
@@ -184,16 +194,18 @@ def register(subparsers) -> None:
                              "Needs --radio-range. A team that cannot go on says so "
                              "(infeasible) and stops. Robots stuck at the end of their "
                              "leash call relays, in both worlds")
-    parser.add_argument("--radio-range", type=float, default=None, metavar="M",
+    parser.add_argument("--radio-range", default=None, metavar="M",
+                        action=number(above=0, most=MAX_RANGE_M,
+                                      why="m; a longer range reaches no further in any arena"),
                         help="radio range, m. Graph world: robots and a base at the root "
                              "talk within it (walls ignored), and the result reports "
                              "messages and the share of time every robot had a route to "
                              "the base. Embodied world: walls block; the robots keep "
-                             "connectivity tables (seed 004) while they move and the result "
+                             "Le et al.'s connectivity tables while they move and the result "
                              "reports how often their beliefs matched the truth; with "
                              "--connectivity they keep their tether to a base on a 1 m mast "
                              "at the root instead")
-    parser.add_argument("--max-time", type=float, default=None, metavar="T",
+    parser.add_argument("--max-time", action=number(above=0), default=None, metavar="T",
                         help="give up after T: graph world time units (default: "
                              "50 (E + 1) + 100); embodied simulated seconds (default: 3600)")
     graph = parser.add_argument_group("graph world")
@@ -201,21 +213,22 @@ def register(subparsers) -> None:
                        help="time to traverse an edge: 'unit' (1 step each, as in the "
                             "paper) or 'length' (length / mean edge length) (default: unit)")
     embodied = parser.add_argument_group("embodied world")
-    embodied.add_argument("--speed", type=float, default=None, metavar="M_S",
+    embodied.add_argument("--speed", action=number(above=0), default=None, metavar="M_S",
                           help=f"initial speed S of every robot, m/s (default: "
-                               f"{PAPER_SPEED_M_S:g}, the paper's experiments; top "
-                               f"speed {spark_v_geometry().max_speed_m_s:.2f}, the robot "
-                               "model's)")
+                               f"{PAPER_SPEED_M_S:g}, the paper's experiments; at most the "
+                               "robot model's top speed)")
     embodied.add_argument("--no-collision-avoidance", action="store_true",
                           help="turn off the bearing-rate speed rule and the vertex-entry "
                                "check, for comparison")
-    embodied.add_argument("--launch-interval", type=float, default=None, metavar="S",
+    embodied.add_argument("--launch-interval", action=number(least=0), default=None,
+                          metavar="S",
                           help="least time between two robots leaving the root, seconds "
                                "(default: 2)")
     embodied.add_argument("--launch-order", default=None, metavar="I,J,...",
                           help="order in which robots R1..RK are put on the root, e.g. "
                                "3,1,2 (default: 1,2,...)")
-    embodied.add_argument("--stall-timeout", type=float, default=None, metavar="S",
+    embodied.add_argument("--stall-timeout", action=number(above=0), default=None,
+                          metavar="S",
                           help="end the run, not completed, when no robot has reached a vertex "
                                "for S simulated seconds (default: 300 s, or 10x the time to "
                                "drive the longest edge if that is longer)")
@@ -224,14 +237,15 @@ def register(subparsers) -> None:
                                "and stays as an obstacle), beacon:V@T (the beacon at vertex V "
                                "is wiped), radio-blackout@T1-T2 (no radio message gets "
                                "through; needs --radio-range)")
-    embodied.add_argument("--line-noise", type=float, default=None, metavar="M",
+    embodied.add_argument("--line-noise", action=number(least=0), default=None, metavar="M",
                           help="standard deviation of the line sensors' noise, m (default: 0)")
-    embodied.add_argument("--ir-noise", type=float, default=None, metavar="M",
+    embodied.add_argument("--ir-noise", action=number(least=0), default=None, metavar="M",
                           help="standard deviation of the IR sensors' noise, m (default: 0)")
-    embodied.add_argument("--wheel-slip", type=float, default=None, metavar="S",
+    embodied.add_argument("--wheel-slip", action=number(least=0), default=None, metavar="S",
                           help="wheel slip: each tick each encoder over-reads its wheel's "
                                "turn by |N(0, S)| of it (default: 0)")
-    embodied.add_argument("--bearing-noise", type=float, default=None, metavar="DEG",
+    embodied.add_argument("--bearing-noise", action=number(least=0), default=None,
+                          metavar="DEG",
                           help="standard deviation of the bearing sensor's noise, degrees "
                                "(default: 0)")
     embodied.add_argument("--physics", choices=PHYSICS, default=None,
@@ -265,24 +279,14 @@ def check_options(args) -> None:
     if args.world == "graph":
         given = [flag for dest, flag in EMBODIED_ONLY.items() if getattr(args, dest)]
         if given:
-            raise MjswarmError(f"{', '.join(given)} only apply to the embodied world "
-                               "(--world embodied)")
+            raise MjswarmError(f"{', '.join(given)} "
+                               f"{'applies' if len(given) == 1 else 'apply'} only to the "
+                               "embodied world (--world embodied)")
     elif args.edge_time is not None:
-        raise MjswarmError("--edge-time only applies to the graph world (--world graph)")
+        raise MjswarmError("--edge-time applies only to the graph world (--world graph)")
     if args.connectivity not in (None, "none"):
         if args.radio_range is None:
             raise MjswarmError(f"--connectivity {args.connectivity} needs --radio-range")
-    if args.radio_range is not None and not args.radio_range > 0:
-        raise MjswarmError(f"radio range must be positive, got {args.radio_range:g} m")
-    if args.max_time is not None and not args.max_time > 0:
-        raise MjswarmError(f"--max-time must be positive, got {args.max_time:g}")
-    for flag, value, least in (("--speed", args.speed, 0.0), ("--stall-timeout",
-                               args.stall_timeout, 0.0), ("--launch-interval",
-                               args.launch_interval, None), ("--line-noise", args.line_noise,
-                               None), ("--ir-noise", args.ir_noise, None),
-                               ("--wheel-slip", args.wheel_slip, None),
-                               ("--bearing-noise", args.bearing_noise, None)):
-        _check_number(flag, value, least)
     if args.launch_order:
         launch_order(args.launch_order, args.robots)
     check_writable(args.json, "JSON")
@@ -291,22 +295,14 @@ def check_options(args) -> None:
     check_video(args)
 
 
-def _check_number(flag: str, value: float | None, above: float | None) -> None:
-    """Refuse, naming ``flag``, a value that is not a finite number greater than
-    ``above`` (None: at least 0)."""
-    if value is None:
-        return
-    if above is None and not (math.isfinite(value) and value >= 0):
-        raise MjswarmError(f"{flag} must be a finite number >= 0, got {value:g}")
-    if above is not None and not (math.isfinite(value) and value > above):
-        raise MjswarmError(f"{flag} must be a finite number > {above:g}, got {value:g}")
-
-
 def run(args) -> int:
     check_options(args)
     try:
         result = WORLDS[args.world](args)
     except RunInterrupted as stop:  # say what is known, then exit as interrupted
+        for key in ("recording", "video"):  # where the partial went, if anywhere
+            if stop.result.get(key):
+                stop.result[key] = interrupted_outputs.get(stop.result[key])
         report(stop.result, args, partial=True)
         raise
     report(result, args)

@@ -1,9 +1,10 @@
-"""Output files of the subcommands: never lose what the user already has (issues 18, 26).
+"""Output files of the subcommands: never lose what the user already has.
 
 * :func:`check_writable` runs before any simulation: a target whose directory is
   missing or read-only, or that is a directory, fails at once in one line, not after a
-  long run. :func:`check_outputs` also refuses two outputs on one file and a file name
-  whose extension is not the format written.
+  long run; :func:`check_directory` does the same for an output directory.
+  :func:`check_outputs` also refuses two outputs on one file and a file name whose
+  extension is not the format written.
 * :func:`atomic_output` hands the writer a temporary file and, when the writer is done,
   puts it in place according to what the target is:
 
@@ -20,7 +21,8 @@
   byte for byte as it was. If the run is interrupted (Ctrl-C) the partial output is kept:
   under the requested name when nothing was there, else beside the user's earlier file
   under :func:`partial_name` (the earlier file is left as it was); a special file gets
-  the partial bytes. :data:`interrupted_outputs` says where each one went, for the CLI's
+  the partial bytes. A partial with nothing to review in it (see :func:`drop_if_useless`)
+  is not kept. :data:`interrupted_outputs` says where each one went, for the CLI's
   message.
 * :func:`write_json` writes ``--json PATH|-`` that way.
 """
@@ -32,14 +34,15 @@ import os
 import shutil
 import stat
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 from mjswarm.errors import MjswarmError
 
-#: Partial outputs of an interrupted run: requested target -> where the partial went.
-interrupted_outputs: dict[str, str] = {}
+#: Partial outputs of an interrupted run: requested target -> where the partial went
+#: (None: nowhere, it held nothing).
+interrupted_outputs: dict[str, str | None] = {}
 
 
 def _stat(path: Path) -> os.stat_result | None:
@@ -75,6 +78,24 @@ def check_writable(target: str | os.PathLike | None, what: str) -> None:
         raise MjswarmError(f"cannot write {what} {path}: directory {folder} is not writable")
     if real.exists() and not os.access(real, os.W_OK):
         raise MjswarmError(f"cannot write {what} {path}: the file is read-only")
+
+
+def check_directory(target: str | os.PathLike | None, what: str) -> None:
+    """Fail now (one line) if the output directory ``target`` could not be made or written:
+    it must be a directory, or a new one in an existing, writable directory (never a
+    whole missing tree, as :func:`check_writable` refuses for files). None passes."""
+    if target is None:
+        return
+    path = Path(target)
+    if path.exists() and not path.is_dir():
+        raise MjswarmError(f"cannot write {what} into {path}: it is not a directory")
+    folder = path if path.is_dir() else Path(os.path.realpath(path)).parent
+    if not folder.is_dir():
+        raise MjswarmError(f"cannot write {what} into {path}: directory {folder} does not "
+                           "exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise MjswarmError(f"cannot write {what} into {path}: directory {folder} is not "
+                           "writable")
 
 
 def check_outputs(outputs: dict[str, str | None], suffixes: dict[str, str]) -> None:
@@ -150,6 +171,8 @@ def _finish(temp: Path, final: Path, special: bool, interrupted: bool, shown: st
     """Put the writer's output in place (an empty one is dropped: nothing was written)."""
     if not (temp.exists() and temp.stat().st_size > 0):
         temp.unlink(missing_ok=True)
+        if interrupted:
+            interrupted_outputs[shown] = None
         return
     if special:
         try:
@@ -171,6 +194,20 @@ def _finish(temp: Path, final: Path, special: bool, interrupted: bool, shown: st
     os.replace(temp, final)
     if interrupted:
         interrupted_outputs[shown] = shown
+
+
+def drop_if_useless(temp: Path, useful: Callable[[], bool]):
+    """An exit callback for an :class:`~contextlib.ExitStack`, pushed between
+    :func:`atomic_output` and the writer of ``temp``: when the block ends by Ctrl-C and
+    ``useful()`` is false (say, a recording that holds no pose yet), ``temp`` is emptied,
+    so that no partial is kept and the CLI says so."""
+
+    def exit_callback(kind, value, traceback) -> bool:
+        if kind is not None and issubclass(kind, KeyboardInterrupt) and not useful():
+            temp.write_bytes(b"")
+        return False
+
+    return exit_callback
 
 
 def write_json(data, target: str | None, partial: bool = False) -> bool:

@@ -16,7 +16,7 @@ def register(subparsers) -> None:
             "every robot's trajectory in its colour, the radio links at the end, where "
             "completion was declared, contact events and a table of headline figures; "
             "from a --json result of `mjswarm explore` the robots' vertex paths on the "
-            "arena graph with seed 003's metrics, of a coverage experiment its S-coverage "
+            "arena graph with Nagavarapu et al.'s exploration metrics, of a coverage experiment its S-coverage "
             "per episode against the paper's mean, of a patrol its headline figures. "
             "The format follows OUT's extension: .png, .svg or .pdf."
         ),

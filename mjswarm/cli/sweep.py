@@ -6,6 +6,7 @@ import sys
 
 from tqdm import tqdm
 
+from mjswarm.cli.numbers import check_number, whole
 from mjswarm.errors import MjswarmError
 
 
@@ -69,17 +70,17 @@ def register(subparsers) -> None:
     parser.add_argument("--backend", default="local",
                         help="local (process pool, default) or ray (pip install -e '.[ray]'; "
                              "connects to RAY_ADDRESS if set)")
-    parser.add_argument("--workers", type=int, default=None, metavar="N",
+    parser.add_argument("--workers", action=whole(), default=None, metavar="N",
                         help="parallel workers (default: all CPUs)")
     parser.set_defaults(func=run)
 
 
 def run(args) -> int:
-    from mjswarm.cli import check_seeds
     from mjswarm.experiments.sweep import ResultsFile, grid, sweep
 
     seeds = _ints(args.seeds, "--seeds")
-    check_seeds(seeds, "--seeds")
+    for seed in seeds:
+        check_number("--seeds", seed, whole=True, least=0)
     cells = grid(args.world, [a for a in args.arenas.split(",") if a],
                  _ints(args.robots, "--robots"), [s for s in args.strategies.split(",") if s],
                  seeds, _floats(args.radio_ranges, "--radio-ranges"),

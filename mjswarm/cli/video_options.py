@@ -7,7 +7,7 @@ import math
 
 from mjswarm.cli.output import check_writable
 from mjswarm.errors import MjswarmError
-from mjswarm.outputs.video import DEFAULT_SPEEDUP, FPS, HEIGHT_PX, WIDTH_PX
+from mjswarm.outputs.video_format import DEFAULT_SPEEDUP, FPS, HEIGHT_PX, WIDTH_PX
 
 
 def add_video_options(parser) -> None:

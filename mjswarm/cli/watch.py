@@ -12,10 +12,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from contextlib import ExitStack
 
-from mjswarm.cli.output import atomic_output
-from mjswarm.outputs.recording import Recorder, Recording
-from mjswarm.outputs.video import Video, filming
-from mjswarm.worlds.loop import LoopFunctions
+from typing import TYPE_CHECKING
+
+from mjswarm.cli.output import atomic_output, drop_if_useless
+
+if TYPE_CHECKING:
+    from mjswarm.worlds.loop import LoopFunctions
 
 
 def watchers(outputs: ExitStack, args, *, robots: int, bounds_m: Sequence[float], name: str,
@@ -23,6 +25,9 @@ def watchers(outputs: ExitStack, args, *, robots: int, bounds_m: Sequence[float]
     """The loop functions for ``args.record`` (a rerun recording of ``robots`` robots with
     radios, no sensors, framed on ``bounds_m``) and ``args.video``; all are finished, in
     the right order, when ``outputs`` closes."""
+    from mjswarm.outputs.recording import Recorder, Recording
+    from mjswarm.outputs.video import Video, filming
+
     functions: list[LoopFunctions] = []
     video = recorder = None
     if args.video:
@@ -30,9 +35,10 @@ def watchers(outputs: ExitStack, args, *, robots: int, bounds_m: Sequence[float]
                       speedup, title=title)
     if args.record:
         temp = outputs.enter_context(atomic_output(args.record, "recording"))
-        recorder = outputs.enter_context(Recorder(temp, None, robots, radio=True,
-                                                  sensors=False, bounds_m=bounds_m,
-                                                  name=name, video=video is not None))
+        recorder = Recorder(temp, None, robots, radio=True, sensors=False, bounds_m=bounds_m,
+                            name=name, video=video is not None)
+        outputs.push(drop_if_useless(temp, lambda: recorder.ticks > 0))
+        outputs.enter_context(recorder)
         functions.append(Recording(recorder))
     if video is not None:
         functions.append(video)

@@ -47,8 +47,6 @@ from mjswarm.errors import MjswarmError
 if TYPE_CHECKING:
     from mjswarm.core.simulation import Simulation
 
-#: The physics tiers: ``"dynamic"``, MuJoCo's contact physics; ``"kinematic"``, this module.
-PHYSICS = ("dynamic", "kinematic")
 #: Overlap (m) a move may add before the contact rule stops the robot (float rounding).
 OVERLAP_TOL_M = 1e-9
 #: Side (m) of the cells of the grid that lists, per cell, the walls a footprint disc

@@ -23,7 +23,6 @@ until the positions change, so the second asker at the same positions costs a co
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 #: relative enlargement of the k-d tree's search radius over the range (the exact test decides)
 CANDIDATE_SLACK = 1e-9
@@ -37,7 +36,7 @@ class Neighbours:
     def __init__(self) -> None:
         self._key: tuple = ()  # the last positions: their shape and bytes
         self._columns = np.empty((0, 0))  # their coordinates, one row per axis
-        self._tree: cKDTree | None = None
+        self._tree = None  # a scipy.spatial.cKDTree, built on the first query
         self._answers: dict[float, np.ndarray] = {}  # range (m) -> its pairs at ``_key``
         #: every pair of ``n`` robots: ``(n, k, l, kl)``, ``kl`` the pairs as rows
         self._every: tuple[int, np.ndarray, np.ndarray, np.ndarray] = _every_pair(0)
@@ -70,6 +69,8 @@ class Neighbours:
             _, k, l, pairs = self._every
         else:
             if self._tree is None:
+                from scipy.spatial import cKDTree  # heavy: imported when first needed
+
                 self._tree = cKDTree(columns.T, balanced_tree=False, compact_nodes=False)
             near = self._tree.query_pairs(range_m * (1.0 + CANDIDATE_SLACK), output_type="ndarray")
             k, l = np.divmod(np.sort(near[:, 0] * n + near[:, 1]), n)

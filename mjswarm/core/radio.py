@@ -128,13 +128,20 @@ def _short(value: Any) -> str:
 
 
 
+#: Longest radio range (m): arenas and floors lie within a kilometre or so of the origin,
+#: so a longer range reaches every robot all the same.
+MAX_RANGE_M = 10_000.0
+
+
 def _check_options(range_m: float | None, edges, drop_prob: float) -> None:
     """Refuse, in one line, a radio with both or neither of a range (m) and explicit
-    edges, a range that is not a positive number, or a drop probability outside [0, 1)."""
+    edges, a range that is not a positive number up to :data:`MAX_RANGE_M`, or a drop
+    probability outside [0, 1)."""
     if (range_m is None) == (edges is None):
         raise MjswarmError("radio: give exactly one of a range (metres) or explicit edges")
-    if range_m is not None and not (math.isfinite(range_m) and range_m > 0):
-        raise MjswarmError(f"radio: range must be a positive number of metres, got {range_m}")
+    if range_m is not None and not (math.isfinite(range_m) and 0 < range_m <= MAX_RANGE_M):
+        raise MjswarmError(f"radio: range must be a positive number of metres up to "
+                           f"{MAX_RANGE_M:g}, got {range_m}")
     if not 0.0 <= drop_prob < 1.0:
         raise MjswarmError(f"radio: drop probability must be in [0, 1), got {drop_prob}")
 

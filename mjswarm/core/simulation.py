@@ -37,7 +37,8 @@ import numpy as np
 
 from mjswarm.core.battery import Battery
 from mjswarm.core.contacts import CollisionCounter
-from mjswarm.core.kinematic import PHYSICS, KinematicDrive
+from mjswarm.core import PHYSICS
+from mjswarm.core.kinematic import KinematicDrive
 from mjswarm.errors import MjswarmError, one_line
 from mjswarm.core.raycast import RayCaster, Rays
 from mjswarm.core.robot import (

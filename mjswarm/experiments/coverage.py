@@ -52,12 +52,14 @@ from algorithms.maintenance.regions import union_area
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.openfloor import EmbodiedFloor, MotionWorld, PointWorld
-from mjswarm.core.robot import spark_v_geometry
 from mjswarm.core.radio import Radio
 
 MAX_ROBOTS = 10
 START_ROBOTS = 5
 WORLDS = ("embodied", "point")
+#: Largest region diameter D (m): the embodied floor reaches 3 (cr - 1) D per robot, up to
+#: 900 m from the origin at cr 4, and MuJoCo loses millimetres beyond about a kilometre.
+MAX_REGION_DIAMETER_M = 10.0
 #: the paper's S-coverage means (percent) by (cr, placement)
 PAPER_COVERAGE = {(2.0, "heuristic"): 73.0, (4.0, "heuristic"): 91.0,
                   (2.0, "min-intersection"): 75.0}
@@ -141,11 +143,16 @@ class CoverageRun(LoopFunctions):
             raise MjswarmError(f"unknown world {world!r} (choose from {', '.join(WORLDS)})")
         if not region_diameter_m > 0.2:
             raise MjswarmError("region diameter must exceed 0.2 m (a robot is 0.15 m wide)")
+        if not region_diameter_m <= MAX_REGION_DIAMETER_M:
+            raise MjswarmError(f"region diameter must be at most {MAX_REGION_DIAMETER_M:g} m "
+                               "(the floor would reach beyond a kilometre)")
         self.cr, self.placement, self.world_name = float(cr), placement, world
         if clearance_m is None:
             clearance_m = CLEARANCE_M if world == "embodied" else 0.0
         if not (math.isfinite(clearance_m) and 0.0 <= clearance_m < region_diameter_m):
             raise MjswarmError(f"clearance must be in [0, region diameter), got {clearance_m}")
+        from mjswarm.core.robot import spark_v_geometry  # loads MuJoCo
+
         self.params = Params(link_m=(cr - 1.0) * region_diameter_m,
                              region_radius_m=region_diameter_m / 2.0,
                              max_robots=MAX_ROBOTS, placement=placement,

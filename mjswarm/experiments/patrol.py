@@ -56,6 +56,11 @@ STEP_S = 0.15
 #: Kobayashi et al.'s turn-rate cap, 0.15 rad per timestep (Sect. III-C).
 PAPER_TURN_CAP_RAD_PER_STEP = 0.15
 WORLDS = ("embodied", "point")
+#: Fewest robots a patrol takes: the base station, the leader and one explorer.
+MIN_ROBOTS = 3
+#: Most robots a patrol takes: a step costs about N^2 (every pair's links, the AAT), and
+#: 300 point robots already take about a second a step.
+MAX_ROBOTS = 200
 
 
 @dataclass
@@ -85,7 +90,7 @@ class TrialResult:
 def initial_positions(n: int, rng: np.random.Generator, params: RoleParams,
                       attempts: int = 1000) -> np.ndarray:
     """Draw the deployment of Sect. IV-B (see the module docstring); (N, 2) in metres."""
-    if n < 3:
+    if n < MIN_ROBOTS:
         raise MjswarmError(f"the patrol needs at least 3 robots (base station, leader, "
                            f"explorer), got {n}")
     radius = 0.6 * math.sqrt(n)

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 from tqdm import tqdm
 
 from mjswarm.arena import ArenaSpec, load_arena, parse_arena_spec
+from mjswarm.core import PHYSICS
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedResult, explore_embodied
 from mjswarm.experiments.faults import parse_fault
 
@@ -57,7 +58,6 @@ ARENAS = (
 )
 SPEEDS_M_S = (0.05, 0.1, 0.15, 0.2)
 TEAMS = (1, 4, 10)
-PHYSICS = ("dynamic", "kinematic")
 
 
 @dataclass(frozen=True)

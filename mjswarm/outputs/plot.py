@@ -1,4 +1,4 @@
-"""A summary picture of any run (issue 15): ``mjswarm plot RESULT -o OUT.png``.
+"""A summary picture of any run: ``mjswarm plot RESULT -o OUT.png``.
 
 From a recording (``.rrd``, any run recorded with ``--record``): the arena when there is
 one (the lines on the floor, the walls, the vertices with their names above everything
@@ -22,6 +22,7 @@ from __future__ import annotations
 import json
 import re
 import textwrap
+import warnings
 from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -71,7 +72,9 @@ def read_recording(path: str | Path) -> Trace:
     poses: dict[str, list] = defaultdict(list)
     last_links: tuple[int, list] = (-1, [])
     try:
-        chunks = list(rr.chunk.RrdReader(path).stream())
+        with warnings.catch_warnings():  # the reader's notes on the file's layout
+            warnings.simplefilter("ignore", rr.error_utils.RerunWarning)
+            chunks = list(rr.chunk.RrdReader(path).stream())
     except Exception as exc:  # noqa: BLE001 - any reader failure means "not a recording"
         raise MjswarmError(f"cannot read recording {path}: {one_line(exc)}") from None
     for chunk in chunks:
@@ -299,7 +302,7 @@ def _plot_coverage(data: dict, out, fmt: str) -> None:
                    label=f"paper: {100 * data['paper_mean_coverage']:.0f} %")
     ax.set_xlabel("episode")
     ax.set_ylabel("S-coverage (%)")
-    ax.set_title(f"biconnected coverage (seed 002), cr {data['cr']:g}, "
+    ax.set_title(f"biconnected coverage (Ahmadi & Stone), cr {data['cr']:g}, "
                  f"{data['placement']} placement, {data['world']} world, seed {data['seed']}")
     ax.grid(True, linewidth=0.3)
     ax.legend()
@@ -316,7 +319,7 @@ def _plot_patrol(data: dict, out, fmt: str) -> None:
             ("algebraic connectivity", f"{data['algebraic_connectivity']:.3f}")]
     if data.get("collisions_per_trial") is not None:
         rows.append(("contacts per trial", f"{data['collisions_per_trial']:.1f}"))
-    _table(ax, rows, f"patrol (seed 001), {data['world']} world")
+    _table(ax, rows, f"patrol (Kobayashi et al.), {data['world']} world")
     _save(fig, out, fmt)
 
 

@@ -270,6 +270,8 @@ class Recorder:
                                                video, self.graph_scale,
                                                maps=arena is not None))
         self._closed = False
+        #: Ticks logged so far (0: the file holds the static scene only, no pose).
+        self.ticks = 0
         self._buffers(self._chunk, n)
         self._log_static(arena, float(robot_radius_m))
 
@@ -379,6 +381,7 @@ class Recorder:
         speed = np.zeros(n) if speed is None else speed
         self._check_tick(poses, speed, line, ir, bearings, encoders, battery)
         k = self._rows
+        self.ticks += 1
         self._steps[k] = step
         self._times[k] = sim_time_s
         self._poses[k] = poses

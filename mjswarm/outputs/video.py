@@ -46,14 +46,8 @@ import mjswarm
 from mjswarm.errors import MjswarmError, one_line
 from mjswarm.core.contacts import robot_name
 from mjswarm.outputs.recording import robot_color
+from mjswarm.outputs.video_format import DEFAULT_SPEEDUP, FPS, HEIGHT_PX, WIDTH_PX
 from mjswarm.worlds.loop import Loop, LoopFunctions, Scene
-
-#: Frames per second of video.
-FPS = 30
-#: Default simulated seconds per second of video (a 420 s run lasts 14 s).
-DEFAULT_SPEEDUP = 30.0
-#: Frame size (pixels).
-WIDTH_PX, HEIGHT_PX = 640, 480
 #: The overview camera's tilt from looking straight down (degrees).
 CAMERA_TILT_DEG = 20.0
 #: Vertical field of view of the overview camera (degrees; MuJoCo's free camera default).

@@ -34,7 +34,6 @@ from algorithms.motion import track_velocity
 from algorithms.robot import Command, Detection, Observation
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.loop import World
-from mjswarm.core.robot import spark_v_geometry
 
 #: The turn rate we allow the tracker (rad/s); the top speed is the robot model's.
 OMEGA_MAX_RAD_S = 2.0
@@ -156,6 +155,8 @@ class MotionWorld(World, ABC):
         """Follow every present robot's command for one control period, then the radio.
         The velocity tracker (the robot's own motion control) steers by the positioning
         reading the robot observed this tick: one reading per tick."""
+        from mjswarm.core.robot import spark_v_geometry  # loads MuJoCo
+
         if self._sensed is None:
             self._sensed = self.sense()
         sensed = self._sensed
