@@ -73,8 +73,8 @@ def test_a_missing_output_directory_is_named(tmp_path, capsys):
 
 @pytest.mark.parametrize("option, words", [
     (["--video", "x.mp4"], "--video applies only to the embodied world"),
-    (["--record", "x.rrd"], "--record applies only to the embodied world"),
-    (["--speed", "0.1", "--record", "x.rrd"], "--speed, --record apply only to the embodied"),
+    (["--speed", "0.1"], "--speed applies only to the embodied world"),
+    (["--speed", "0.1", "--video", "x.mp4"], "--speed, --video apply only to the embodied"),
 ])
 def test_embodied_options_in_the_graph_world_read_well(tmp_path, capsys, monkeypatch, option,
                                                        words):

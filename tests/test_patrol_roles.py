@@ -149,7 +149,7 @@ def test_patrol_cli_json_and_errors(capsys):
     assert data["aat_robots"]["angle_tests_per_robot_step"] <= \
         data["aat_every_step"]["angle_tests_per_robot_step"]
     assert main(["experiment", "patrol", "--world", "point", "--robots", "2"]) == 2
-    assert "at least 3 robots" in capsys.readouterr().err
+    assert "--robots must be a whole number >= 3" in capsys.readouterr().err
 
 
 @pytest.mark.slow

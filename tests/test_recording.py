@@ -286,7 +286,7 @@ def test_view_with_display_runs_the_rerun_viewer(fig9_recording, monkeypatch):
      {"/robots/R1/trail", "/robots/R1/state/busy", "/robots/R6/state/known_regions",
       "/radio/graph", "/radio/links", "/events/R6"}),
     (["experiment", "patrol", "--world", "point", "--robots", "5", "--steps", "120"],
-     {"/robots/R2/trail", "/robots/R2/state/role", "/robots/R1/state/connections",
+     {"/robots/R2/trail", "/states/R2/role", "/robots/R1/state/connections",
       "/radio/graph", "/radio/links"}),
 ])
 def test_coverage_and_patrol_runs_record_and_verify(tmp_path, capsys, argv, entities):
