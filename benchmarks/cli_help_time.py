@@ -26,11 +26,16 @@ def median_wall_s(command: list[str], runs: int) -> float:
     return statistics.median(times)
 
 
-parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-parser.add_argument("--runs", type=int, default=7, help="timed runs of each command")
-args = parser.parse_args()
+def measure(runs: int = 7) -> tuple[float, float]:
+    """Median wall times (s) of ``mjswarm --help`` and of ``python -c pass``."""
+    bare = median_wall_s([sys.executable, "-c", "pass"], runs)
+    return median_wall_s([sys.executable, "-m", "mjswarm.cli", "--help"], runs), bare
 
-bare = median_wall_s([sys.executable, "-c", "pass"], args.runs)
-help_ = median_wall_s([sys.executable, "-m", "mjswarm.cli", "--help"], args.runs)
-print(f"mjswarm --help: {help_:.3f} s median of {args.runs} runs "
-      f"(python -c pass: {bare:.3f} s; mjswarm's share {help_ - bare:.3f} s)")
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=7, help="timed runs of each command")
+    args = parser.parse_args()
+    help_, bare = measure(args.runs)
+    print(f"mjswarm --help: {help_:.3f} s median of {args.runs} runs "
+          f"(python -c pass: {bare:.3f} s; mjswarm's share {help_ - bare:.3f} s)")

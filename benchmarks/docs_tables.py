@@ -202,10 +202,35 @@ def graph_world() -> str:
             + "\n\nCommand: `python benchmarks/graphworld_bench.py`.")
 
 
+def record_cost() -> str:
+    from benchmarks.record_cost import compare
+
+    r = compare(repeats=2, log=lambda line: print(line, file=sys.stderr))
+    rows = [["without a recording", f"{r['bare_wall_s']:.1f}", f"{r['bare_cpu_s']:.1f}"],
+            [f"with `--record` ({r['size_mb']:.0f} MB)", f"{r['recorded_wall_s']:.1f}",
+             f"{r['recorded_cpu_s']:.1f}"],
+            ["ratio", f"{r['recorded_wall_s'] / r['bare_wall_s']:.2f}",
+             f"{r['recorded_cpu_s'] / r['bare_cpu_s']:.2f}"]]
+    return (table(["main job (`arena2`, 4 robots)", "wall time (s)", "CPU time (s)"], rows)
+            + f"\n\nBest of two interleaved runs each, {r['sim_time_s']:.0f} s simulated. "
+            "Command: `python benchmarks/record_cost.py`.")
+
+
+def cli_help() -> str:
+    from benchmarks.cli_help_time import measure
+
+    runs = 7
+    help_s, bare_s = measure(runs)
+    rows = [["`mjswarm --help`", f"{help_s:.2f}"], ["`python -c pass`", f"{bare_s:.2f}"]]
+    return (table(["command", f"wall time (s), median of {runs}"], rows)
+            + "\n\nCommand: `python benchmarks/cli_help_time.py`.")
+
+
 GROUPS: dict[str, dict[str, Callable[[], str]]] = {
     "papers": {"fig9": fig9, "comparisons": comparisons, "trees": trees,
                "embodied": embodied, "coverage": coverage, "forwarding": forwarding},
-    "performance": {"bench": bench, "main_job": main_job, "graph_world": graph_world},
+    "performance": {"bench": bench, "main_job": main_job, "graph_world": graph_world,
+                    "record_cost": record_cost, "cli_help": cli_help},
 }
 
 
