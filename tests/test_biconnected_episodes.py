@@ -99,8 +99,8 @@ def test_cli_json_has_mean_coverage(capsys):
 
 
 @pytest.mark.parametrize("argv,words", [
-    (["--cr", "2", "--episodes", "0"], "at least one episode"),
-    (["--cr", "2", "--region-diameter", "0.1"], "region diameter"),
+    (["--cr", "2", "--episodes", "0"], "--episodes must be a whole number >= 1"),
+    (["--cr", "2", "--region-diameter", "0.1"], "--region-diameter must be"),
 ])
 def test_cli_user_errors_are_one_line(capsys, argv, words):
     code = main(["experiment", "biconnected-coverage", "--world", "point", *argv])

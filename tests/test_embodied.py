@@ -106,7 +106,7 @@ def _texts(rrd) -> dict[str, list[str]]:
         (["--launch-order", "1,1"], "--launch-order must name each of R1..R2 once"),
         (["--launch-order", "a,b"], "--launch-order takes robot numbers"),
         (["--world", "moon"], "unknown world"),
-        (["--robots", "0"], "at least one robot"),
+        (["--robots", "0"], "--robots must be a whole number >= 1"),
         (["--fault", "quake@3"], "bad fault 'quake@3'"),
         (["--fault", "robot:7@3"], "there are robots 1..2"),
         (["--fault", "beacon:v99@3"], "'v99' is not a vertex"),

@@ -108,7 +108,7 @@ def test_links_do_not_depend_on_the_k_d_trees_rounding(monkeypatch):
         def query_pairs(self, r, *args, **kwargs):
             return super().query_pairs(r * (1 - 1e-12), *args, **kwargs)
 
-    monkeypatch.setattr("mjswarm.core.neighbours.cKDTree", ShortTree)
+    monkeypatch.setattr("scipy.spatial.cKDTree", ShortTree)  # imported when first used
     for seed in range(1, 40, 4):  # the dyadic lattices of random_team
         ids, positions, range_m = random_team(seed)
         radio = Radio(ids, range_m=range_m)
