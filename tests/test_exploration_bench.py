@@ -35,9 +35,9 @@ def test_embodied_bench_compares_the_loop_with_bare_physics_of_the_same_run():
     from mjswarm.experiments.minds import make_minds
 
     start = time.perf_counter()
-    r = load_bench("exploration_bench").bench("fig9", robots=1, speed_m_s=0.2)
+    r = load_bench("exploration_bench").bench("fan:3:45", robots=1, speed_m_s=0.2)
     elapsed = time.perf_counter() - start
-    alone = EmbodiedExploration(load_arena("fig9"), make_minds("incidence-dfs", 1),
+    alone = EmbodiedExploration(load_arena("fan:3:45"), make_minds("incidence-dfs", 1),
                                 EmbodiedConfig(speed_m_s=0.2), 0).run()
     assert r["completed"] == alone.completed is True
     assert r["sim_time_s"] == alone.sim_time_s > 10

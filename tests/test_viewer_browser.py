@@ -31,10 +31,11 @@ pytestmark = pytest.mark.skipif(browser_missing() is not None,
 
 
 def map_positions(path: Path) -> dict[str, list[np.ndarray]]:
-    """Robot map entity -> the node positions (graph units) of each map logged."""
+    """Graph view entity (each robot's map, the radio graph) -> the node positions (graph
+    units) of each graph logged."""
     maps: dict[str, list[np.ndarray]] = {}
     for chunk in rr.chunk.RrdReader(path).stream():
-        if not chunk.entity_path.startswith("/map/"):
+        if not chunk.entity_path.startswith(("/map/", "/radio/graph")):
             continue
         batch = chunk.to_record_batch()
         if "GraphNodes:positions" in batch.schema.names:
@@ -56,15 +57,35 @@ def recording(tmp_path_factory) -> Path:
     return path
 
 
-def test_map_vertices_stand_farther_apart_than_a_label(recording):
-    maps = map_positions(recording)
-    assert maps, "no explored map in the recording"
+#: Runs of every world that records graphs, for the check of their graph views' units.
+GRAPH_RUNS = {
+    "graph world": ["explore", "--world", "graph", "--arena", "fig9", "--robots", "2"],
+    "radio graph world": ["explore", "--world", "graph", "--arena", "fig9", "--robots", "3",
+                          "--radio-range", "1.5", "--connectivity", "connected"],
+}
+
+
+def assert_labels_apart(maps: dict[str, list[np.ndarray]]) -> None:
+    assert maps, "no graph view in the recording"
     for entity, logged in maps.items():
         for xy in logged:
             if len(xy) > 1:
                 d = np.hypot(*(xy[:, None] - xy[None]).transpose(2, 0, 1))
                 closest = d[np.triu_indices(len(xy), 1)].min()
                 assert closest > LABEL_UNITS, (entity, closest)
+
+
+def test_map_vertices_stand_farther_apart_than_a_label(recording):
+    assert_labels_apart(map_positions(recording))
+
+
+@pytest.mark.parametrize("run", GRAPH_RUNS, ids=str)
+def test_every_worlds_graph_views_keep_labels_apart(run, tmp_path):
+    path = tmp_path / "run.rrd"
+    assert main([*GRAPH_RUNS[run], "--record", str(path)]) in (0, 1)
+    maps = map_positions(path)
+    assert "/radio/graph" not in maps  # laid out by the viewer: robots share vertices
+    assert_labels_apart(maps)
 
 
 def test_default_layout_in_a_browser(recording, tmp_path):

@@ -30,7 +30,7 @@ is right-handed, z up, the floor at z = 0)::
     matrices/R<k>             TextDocument (markdown): the incidence matrix R<k> carries,
                               after each of its vertex calls
     beacons/<vertex>          TextDocument: the beacon's contents (beacon-side vertex id)
-    radio/graph               GraphNodes + GraphEdges: who hears whom, in graph units
+    radio/graph               GraphNodes + GraphEdges: who hears whom, laid out by the viewer
     radio/links               LineStrips3D: the same edges drawn between the robots
     radio/tethers             LineStrips3D: each robot's link to its tether parent
     radio/truth               TextDocument: ground truth and the robots' beliefs
@@ -55,11 +55,13 @@ per tick. Choices:
   instead of a whole strip.
 * Bearings are sparse (a robot sees few others), so each observed pair gets its own
   series, drawn as points, sent only at the ticks of the observations.
-* Graph views (``map/*``, ``radio/graph``) use the positions given, with y negated and
+* The maps (``map/*``) use the vertices' positions, with y negated and
   scaled by :attr:`Recorder.graph_scale`: rerun's graph view draws y downwards, and
   places nodes in its own units, where a node's label is some 30-60 units wide, so the
   scale puts the closest two vertices of the arena :data:`GRAPH_SPACING` units apart
-  and every vertex's label stands apart from the others.
+  and every vertex's label stands apart from the others. The radio graph
+  (``radio/graph``) is topology, and robots often stand together (on the root, in the
+  depot), so the viewer lays it out by forces; ``radio/links`` draws it over the arena.
 * The arena view looks straight down on the arena (x to the right, y up), from a
   height at which the arena fills the view.
 * An explored graph identical to the one last logged for that robot is not logged again.
@@ -607,13 +609,11 @@ class Recorder:
                       for i in range(n)]
         xy = self._positions()
         fixed = dict(fixed or {})
-        k = self.graph_scale
-        node_xy = None if xy is None else [*(xy * (k, -k)), *((k * x, -k * y)
-                                                             for x, y in fixed.values())]
         pairs = [(ids[a], ids[b]) for a, b in edges] + [(ids[a], f) for a, f in fixed_links]
+        # who hears whom is topology: the graph view lays it out by forces, so robots that
+        # stand together keep their labels apart (radio/links draws it over the arena)
         self._stream.log("radio/graph",
-                         rr.GraphNodes([*ids, *fixed], positions=node_xy,
-                                       labels=[*labels, *fixed],
+                         rr.GraphNodes([*ids, *fixed], labels=[*labels, *fixed],
                                        colors=[*colors, *([_ROOT_COLOR] * len(fixed))]),
                          rr.GraphEdges(pairs, graph_type="undirected"))
         if xy is not None:
@@ -759,7 +759,7 @@ def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
                              name=r, row_shares=[3, 2]) for r in robots]
     else:
         maps = [rrb.GraphView(name="maps", origin="/map", visual_bounds=frame)]
-    radio_views = [rrb.GraphView(name="radio", origin="/radio/graph", visual_bounds=frame),
+    radio_views = [rrb.GraphView(name="radio", origin="/radio/graph"),
                    rrb.TextDocumentView(name="radio truth", origin="/radio/truth")]
     beacons = [rrb.TextDocumentView(name="beacons", origin="/beacons")] if maps else []
     graphs = [*maps, *beacons, *(radio_views if radio else [])]
