@@ -51,6 +51,7 @@ def test_a_long_stop_creeps_on_while_the_front_is_clear_and_stops_for_a_body(rob
     assert held(robot, 1.0, math.nan)[-1] == 0.0  # and a new stop waits again
 
 
+@pytest.mark.slow
 def test_the_phantom_wait_of_a_dense_team_ends():
     """``lattice:6x6``, 8 robots, 0.15 m/s, seed 1 stalls without the creep: a robot on its
     lane is held by the rule for one standing on the vertex beyond the next, which waits

@@ -99,7 +99,8 @@ def test_a_pass_next_to_a_vertex_steps_across_with_its_sensor_on_the_incoming_sp
     assert sensor_m >= SPOKE_INNER_RADIUS_M + 0.01, sensor_m
 
 
-@pytest.mark.parametrize("dies_at_s", [25.6, 90, 91])
+@pytest.mark.parametrize("dies_at_s", [pytest.param(25.6, marks=pytest.mark.slow), 90,
+                                       pytest.param(91, marks=pytest.mark.slow)])
 def test_a_robot_passes_a_dead_one_and_the_team_completes_the_true_map(dies_at_s):
     """``arena2``, 4 robots: R1 fails at 90 s at the start of its corridor from v3 to v4;
     the robot sent along that edge next passes it (without passing, the run stalls). At
