@@ -341,6 +341,7 @@ def test_embodied_team_completes_a_map_that_needs_a_robot_standing_between():
     assert result.collisions == 0 and result.cut_ticks == 0 and result.connected_share == 1.0
 
 
+@pytest.mark.slow  # the docked-robot-fails case below runs the same team by default
 def test_embodied_biconnected_team_completes_with_its_first_robot_docked():
     """arena1, 3 robots at 3 m, 10 cm/s: R1 docks at the base (rule 1), R2 and R3 explore
     the true map with two disjoint routes to the base in every tick and 0 contacts."""

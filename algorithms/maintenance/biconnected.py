@@ -264,9 +264,14 @@ class BiconnectedRobot(Controller):
 
     def telemetry(self) -> dict[str, float]:
         """Busy (joining or leading a repair), regions it knows, MOVE floods and
-        distributed checks it led."""
-        return {"busy": float(self.busy), "known_regions": len(self.table),
-                "moves_led": self.moves_led, "checks_led": self.checks_led}
+        distributed checks it led, and the region it guards: its centre (m) and radius
+        (m; absent while it has none)."""
+        out = {"busy": float(self.busy), "known_regions": len(self.table),
+               "moves_led": self.moves_led, "checks_led": self.checks_led}
+        if self.centre is not None:
+            out |= {"region_x_m": float(self.centre[0]), "region_y_m": float(self.centre[1]),
+                    "region_radius_m": self.params.region_radius_m}
+        return out
 
     def tick(self, now: int, inbox: Iterable[Message], neighbors: Iterable[Hashable],
              pose: Sequence[float]) -> tuple[list[Message], Point]:

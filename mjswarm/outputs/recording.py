@@ -34,6 +34,7 @@ is right-handed, z up, the floor at z = 0)::
     radio/links               LineStrips3D: the same edges drawn between the robots
     radio/tethers             LineStrips3D: each robot's link to its tether parent
     radio/truth               TextDocument: ground truth and the robots' beliefs
+    regions                   LineStrips3D: the regions robots guard, as circles on the floor
     events                    TextLog: run-wide events (launches of faults, completion, the end)
     events/R<k>               TextLog: robot R<k>'s events (vertex visits, speed changes, stops)
 
@@ -296,6 +297,7 @@ class Recorder:
         self._latest_xy: np.ndarray | None = None  # (n, 2): last position logged
         self._last_map: dict[int, tuple] = {}
         self._last_state: dict[tuple[int, str], str] = {}
+        self._regions: dict[int, tuple[float, float, float]] = {}
         self._state: dict[tuple[int, str], tuple[list[int], list[float]]] = {}
 
     # --- static data -------------------------------------------------------------------
@@ -547,6 +549,20 @@ class Recorder:
             rr.GraphEdges(list(edges), graph_type="undirected"),
         )
 
+    def log_regions(self, step: int, sim_time_s: float,
+                    regions: Mapping[int, tuple[float, float, float]]) -> None:
+        """The regions robots guard: robot index -> (x m, y m, radius m), drawn as circles
+        on the floor in the robots' colours; logged only when they change."""
+        if regions == self._regions:
+            return
+        self._regions = dict(regions)
+        self._at(step, sim_time_s)
+        turn = np.linspace(0.0, 2.0 * np.pi, 49)
+        self._stream.log("regions", rr.LineStrips3D(
+            [np.column_stack([x + r * np.cos(turn), y + r * np.sin(turn),
+                              np.full_like(turn, 0.003)]) for x, y, r in regions.values()],
+            colors=[robot_color(i) for i in regions], radii=0.004))
+
     def log_state(self, step: int, sim_time_s: float, robot: int, state: str,
                   lane: str = "decision", changes_only: bool = False) -> None:
         """Robot ``robot``'s controller enters ``state`` (a name) in ``lane``
@@ -742,7 +758,7 @@ def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
     scene = rrb.Spatial3DView(
         name="arena (from above)",
         origin="/",
-        contents=["+ /arena/**", "+ /robots/**"]
+        contents=["+ /arena/**", "+ /robots/**", "+ /regions"]
         + (["+ /radio/links", "+ /radio/tethers"] if radio else []),
         overrides={f"/robots/{r}/trail": trail_range for r in robots},
         eye_controls=top_down_eye(bounds_m),
@@ -811,7 +827,7 @@ class Recording(LoopFunctions):
         world, rec = loop.world, self.recorder
         step, now = loop.ticks, world.time_s
         poses = world.true_poses()
-        state = {}
+        state, regions = {}, {}
         for i, c in loop.controllers.items():
             if world.present[i]:
                 telemetry = c.telemetry()
@@ -819,7 +835,11 @@ class Recording(LoopFunctions):
                 for lane, name in telemetry.items():
                     if isinstance(name, str):
                         rec.log_state(step, now, i, name, lane=lane, changes_only=True)
+                if "region_radius_m" in telemetry:
+                    regions[i] = (telemetry["region_x_m"], telemetry["region_y_m"],
+                                  telemetry["region_radius_m"])
         rec.log_tick(step, now, poses, speed=world.commanded_speeds(), state=state)
+        rec.log_regions(step, now, regions)
         events = world.contact_events() or []
         for _, i, j in events[self._contacts:]:
             rec.log_event(step, now, contact_event(i, j, poses))
