@@ -152,19 +152,26 @@ def has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
-def open_viewer(path: str | Path) -> int:
-    """Open the recording at ``path`` in the rerun viewer; returns the viewer's exit status.
-
-    Blocks until the viewer window is closed. Raises :class:`MjswarmError` (one line,
-    at once) if the file is missing or not an ``.rrd`` recording (rerun's files start
-    with ``RRF``), or if there is no display.
-    """
+def check_recording(path: str | Path) -> None:
+    """Refuse, in one line, a path that is no rerun recording (rerun's files start
+    with ``RRF``)."""
     path = Path(path)
     if not path.is_file():
         raise MjswarmError(f"no recording at {path}")
     with path.open("rb") as f:
         if f.read(3) != b"RRF":
             raise MjswarmError(f"{path} is not a rerun .rrd recording")
+
+
+def open_viewer(path: str | Path) -> int:
+    """Open the recording at ``path`` in the rerun viewer; returns the viewer's exit status.
+
+    Blocks until the viewer window is closed. Raises :class:`MjswarmError` (one line,
+    at once) if the file is missing or not an ``.rrd`` recording (:func:`check_recording`),
+    or if there is no display.
+    """
+    path = Path(path)
+    check_recording(path)
     if not has_display():
         raise MjswarmError(
             f"no display (DISPLAY and WAYLAND_DISPLAY are unset), cannot open the viewer; "

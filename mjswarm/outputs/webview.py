@@ -26,7 +26,7 @@ from urllib.parse import quote
 import numpy as np
 
 from mjswarm.errors import MjswarmError
-from mjswarm.outputs.recording import rerun_command
+from mjswarm.outputs.recording import check_recording, rerun_command
 
 #: Where Debian puts Chromium and its driver (``apt-get install chromium chromium-driver``).
 CHROMIUM = "/usr/bin/chromium"
@@ -89,13 +89,19 @@ def serve(files: list[str | Path], timeout_s: float = 30.0) -> Iterator[str]:
             time.sleep(0.2)
         yield web_address(web, grpc)
     finally:
+        stop(proc)
+        log.close()
+
+
+def stop(proc: subprocess.Popen) -> None:
+    """End ``proc`` if it still runs: SIGTERM, then SIGKILL after 10 s."""
+    if proc.poll() is None:
         proc.terminate()
         try:
             proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.wait()
-        log.close()
 
 
 def serve_web(path: str | Path, port: int | None = None, grpc_port: int | None = None,
@@ -131,24 +137,9 @@ def serve_web(path: str | Path, port: int | None = None, grpc_port: int | None =
               file=out, flush=True)
         return proc.wait()
     finally:
-        if proc.poll() is None:
-            proc.terminate()
-            try:
-                proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+        stop(proc)
 
 
-def check_recording(path: str | Path) -> None:
-    """Refuse, in one line, a path that is no rerun recording (rerun's files start
-    with ``RRF``)."""
-    path = Path(path)
-    if not path.is_file():
-        raise MjswarmError(f"no recording at {path}")
-    with path.open("rb") as f:
-        if f.read(3) != b"RRF":
-            raise MjswarmError(f"{path} is not a rerun .rrd recording")
 
 
 #: Where the default layout (:func:`mjswarm.outputs.recording._blueprint`, exploration
