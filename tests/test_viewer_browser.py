@@ -1,8 +1,9 @@
 """A recording as a reader sees it: served with rerun's own web viewer on 127.0.0.1 and
 opened in a headless Chromium (selenium, the system's chromedriver; nothing downloaded).
 
-One page load (some 20-40 s): the default layout, once the data has loaded, must show
-every robot's colour in the arena view and no empty view; and, from the recording's data,
+Two page loads, an embodied and a graph-world recording (some 20-40 s each): the default
+layout, once the data has loaded, must show every robot's colour in the arena view and no
+empty view; and, from the recording's data,
 every map view's vertices must stand farther apart than a label is wide in rerun's graph
 units (else the labels stack on one spot). The screenshot, and each view cut out of it,
 are kept under ``tmp_path``.
@@ -89,14 +90,19 @@ def test_every_worlds_graph_views_keep_labels_apart(run, tmp_path):
 
 
 def test_default_layout_in_a_browser(recording, tmp_path):
-    with serve([recording]) as address, Browser() as browser:
-        browser.look(address)
-        pixels = browser.save(tmp_path / "default_layout.png")
-    for name in LAYOUT_REGIONS:
-        view = crop(pixels, name)
-        save_png(view, tmp_path / f"{name}.png")
-        assert view.std() > 3.0, f"the {name} view is empty"
-    arena = crop(pixels, "arena").astype(int)
-    for i in range(2):
-        near = (np.abs(arena - np.array(robot_color(i)[:3])) < 30).all(axis=2)
-        assert near.sum() >= 30, f"R{i + 1}'s colour is not in the arena view"
+    """The embodied recording and a graph-world one, in one browser."""
+    graph = tmp_path / "graph.rrd"
+    assert main([*GRAPH_RUNS["graph world"], "--record", str(graph)]) == 0
+    with Browser() as browser:
+        for kind, path in (("embodied", recording), ("graph", graph)):
+            with serve([path]) as address:
+                browser.look(address)
+                pixels = browser.save(tmp_path / f"{kind}_default_layout.png")
+            for name in LAYOUT_REGIONS:
+                view = crop(pixels, name)
+                save_png(view, tmp_path / f"{kind}_{name}.png")
+                assert view.std() > 3.0, f"the {name} view of the {kind} run is empty"
+            arena = crop(pixels, "arena").astype(int)
+            for i in range(2):
+                near = (np.abs(arena - np.array(robot_color(i)[:3])) < 30).all(axis=2)
+                assert near.sum() >= 30, f"R{i + 1}'s colour is not in the {kind} arena view"
