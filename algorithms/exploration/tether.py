@@ -1,11 +1,10 @@
 """Exploration that stays connected: the tether every robot keeps to the base.
 
 Nagavarapu et al. explore without communication limits; Kobayashi et al., Ahmadi & Stone
-and Le et al. keep a team
-connected but do not explore. Here each robot explores with its exploration strategy (Nagavarapu et al.) while it
-keeps a radio route to the base station at the root. The strategy decides where to go;
-the tether only gates and delays moves. Every rule below is ours (the seeds give none for
-this combination):
+and Le et al. keep a team connected but do not explore. Here each robot explores with
+Nagavarapu et al.'s strategy while it keeps a radio route to the base station at the
+root. The strategy decides where to go; the tether only gates and delays moves. Every
+rule below is ours (the papers give none for this combination):
 
 1. **Tether.** Every robot has a *parent*: the base or a robot within radio range. The
    parent relation is a tree rooted at the base. For ``biconnected`` every robot but the
