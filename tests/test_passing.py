@@ -10,8 +10,9 @@ import math
 import pytest
 
 from algorithms.collision import CollisionRule
-from algorithms.exploration.entry import STATION, PassRequest
-from algorithms.exploration.explorer import PASS_AFTER_S, PASS_STEADY_M, Explorer
+from algorithms.exploration.entry import STATION
+from algorithms.exploration.passing import PASS_AFTER_S, PASS_STEADY_M, PassRequest
+from algorithms.exploration.explorer import Explorer
 from algorithms.navigation import NavEvent, Navigator, NavigatorState
 from algorithms.navigation.navigator import PASS_MARGIN_M
 from algorithms.robot import Detection, Observation
@@ -43,11 +44,8 @@ def asks(robot: Explorer, seconds: float, fronts, detections=()) -> float | None
     it asked to pass, or None."""
     for tick in range(round(seconds / DT_S)):
         t = tick * DT_S
-        out = []
         seen = {j: d for j, d in enumerate(detections)}
-        robot._stopped_body(Observation(0, t, ir_m=(math.nan, fronts(t), math.nan),
-                                        detections=seen), 0.0, out)
-        if any(isinstance(m.payload, PassRequest) and m.to == STATION for m in out):
+        if isinstance(robot.body_watch.watch(t, fronts(t), True, seen), PassRequest):
             return t
     return None
 
@@ -71,13 +69,13 @@ def test_a_body_that_moves_or_answers_on_the_radio_is_not_passed():
 
 def test_a_held_lane_is_granted_to_nobody_and_closes_no_cycle():
     stations = VertexStations(load_arena("arena2"))
-    stations.passes[9] = ("v4", "v3")  # robot 9 passes a body on the lane v4 -> v3
+    stations.lanes.request(9, "v4", "v3")  # robot 9 passes a body on the lane v4 -> v3
     stations.occupy(0, "v4")
     stations.occupy(1, "v3")
     stations.request(0, "v4", "v3", 1.0)  # a swap of the edge's ends: a closed cycle ...
     stations.request(1, "v3", "v4", 2.0)
     assert stations.grant() == []  # ... but one of its lanes is held
-    stations.passes.pop(9)
+    stations.lanes.done(9)
     assert sorted(stations.grant()) == [(0, "v3"), (1, "v4")]
 
 

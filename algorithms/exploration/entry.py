@@ -44,15 +44,8 @@ and every message is counted with the radio's. The protocol, from the robot's si
    asks for the way its mission takes. A grant names the request's angle, so that one
    overtaken by a withdrawal is known as such. A withdrawn swap leaves the other robot
    waiting, as before, until this one has left the vertex area it was given.
-6. Passing (ours: not in the paper). A robot whose lane is blocked by a body that does not move
-   and is silent (:meth:`~algorithms.exploration.explorer.Explorer._stopped_body`) asks
-   to pass it on the opposite lane: :class:`PassRequest`. The opposite lane leads from
-   the vertex ahead ``w`` back to the vertex it left ``u``; from the request on, the
-   station of ``w`` lets nobody leave along it (``w`` to ``u`` requests wait), and it
-   answers :class:`PassGranted` once no robot is on its way along it (granted ``u``
-   from ``w`` and not yet on ``u``'s centre). The robot passes and, off the opposite
-   lane, sends :class:`PassDone`: the station opens the lane again. The pass is held
-   like a vertex area: one robot per lane, so nothing comes towards it.
+6. Passing a body that stands on a lane for good has its own protocol
+   (:mod:`algorithms.exploration.passing`); a lane held for a pass is granted to nobody.
 7. Closed vertices (ours: a body that cannot be passed). A vertex whose area holds
    a robot that stopped for good is *closed*: its station answers every request for it
    with :class:`EntryBlocked` instead of a grant, at once for requests waiting in its
@@ -145,18 +138,6 @@ class Halted(NamedTuple):
     """Robot → station: I stopped for good (``reason``); release what I hold."""
 
     reason: str
-
-
-class PassRequest(NamedTuple):
-    """Robot → station: a body blocks my lane; hold the opposite lane for me to pass."""
-
-
-class PassGranted(NamedTuple):
-    """Station → robot: the opposite lane is empty and held for you: pass."""
-
-
-class PassDone(NamedTuple):
-    """Robot → station: I am off the opposite lane; open it again."""
 
 
 class GiveUp(NamedTuple):

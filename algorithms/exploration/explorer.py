@@ -34,6 +34,8 @@ It composes, fed only by its own observation:
   leash must still be able to turn), and one that turns back in the area of the vertex
   it arrived at backs out of it at once (that area is its own).
 
+Its modes and the moves between them are in :mod:`algorithms.exploration.modes`.
+
 Choices beyond the paper (the loop functions in :mod:`mjswarm.experiments.exploration` say the rest):
 
 * **The speed rule applies on edges** (following a lane, Nagavarapu et al. Sec. 4 "traversing an
@@ -82,6 +84,17 @@ from algorithms.exploration.events import (
     VertexCalled,
 )
 from algorithms.exploration.relay import ConnectedExplorer
+from algorithms.exploration.leash import Leash
+from algorithms.exploration.modes import (
+    HOLDS_BEHIND,
+    ON_LEG,
+    RETURNING,
+    TERMINAL,
+    TRANSITIONS,
+    WAITING,
+    Mode,
+)
+from algorithms.exploration.passing import BodyWatch, PassGranted
 from algorithms.exploration.tether import Tether
 from algorithms.exploration.entry import (
     STATION,
@@ -94,9 +107,6 @@ from algorithms.exploration.entry import (
     GiveUp,
     Halted,
     LeftVertex,
-    PassDone,
-    PassGranted,
-    PassRequest,
     TurnedBack,
     VertexClear,
     Withdraw,
@@ -133,13 +143,6 @@ CREEP_GUARD_M = 0.06
 #: away (``lattice:6x6``, 12 robots, 0.2 m/s, seed 2). The lane leads to the vertex the
 #: robot holds, so nobody is behind it on it.
 WAIT_BACKOFF_M = 0.04
-#: Passing a stopped body (ours; :meth:`Explorer._stopped_body`): a body its
-#: front IR has seen within range, steady to ``PASS_STEADY_M`` (m: five times the 2 mm
-#: of the noisiest IR the noise grid runs), for ``PASS_AFTER_S`` (s) while the robot stood
-#: on its lane: twice the creep's wait, so that a phantom stop has been crept out of
-#: first.
-PASS_AFTER_S = 10.0
-PASS_STEADY_M = 0.01
 
 
 class VertexCall(NamedTuple):
@@ -180,51 +183,62 @@ class Explorer(Controller):
         self.idle_wait_s = idle_wait_s
         self.table = table
         self.tether = tether
+        self.control_dt_s = control_dt_s
         #: its connected exploration (rules 1-6) around ``strategy``; None without a tether
         self.connected = None if tether is None else ConnectedExplorer(
             tether.me, strategy, tether, spacing=RELAY_SPACING_M)
-        self._on_edge = False  # between a departure and the next arrival
-        self._left_at_m = 0.0  # odometry distance where it left its vertex
-        self._turning = False  # walking back along its edge (rule 6)
-        self._turn_asked = False  # asked to return to the vertex whose area it is still in
-        self._tell_turn = False  # turned on its lane: tells the stations once on the new lane
-        self._held = False  # wanted to move, and the speed rule or vertex entry held it
-        #: whether its tether declared the exploration infeasible (rule 5)
-        self.infeasible = False
-        self._trail: list[tuple[float, float]] = []  # moves since its parents were all linked
-        #: the ways along its leg (+1 on, -1 back) in which a wall cut a parent's link,
-        #: and those parents
-        self._occluded: set[int] = set()
-        self._cut: set = set()
-        self._parents_then = None if tether is None else tether.parents
-        self.control_dt_s = control_dt_s
+        #: its leash on bodies (None without a tether)
+        self.leash = None if tether is None else Leash(tether)
+        #: passing bodies on its lane (None where it does not pass: tethered, or no radius)
+        self.body_watch = (BodyWatch(calibration.body_radius_m)
+                           if tether is None and calibration.body_radius_m is not None
+                           else None)
         self.nav = Navigator(calibration, conventions, 0.0, speed_m_s, turn_rate_rad_s)
+        #: what it is doing (:class:`Mode`)
+        self.mode = Mode.SCANNING
         #: every vertex call so far (for the loop functions' metrics and recordings)
         self.calls: list[VertexCall] = []
         #: why it stopped for good, or None
         self.halted: str | None = None
-        #: whether its strategy finished: declared the exploration complete, or finished
-        #: the part it can reach, cut off from the root (``CUT_OFF``)
-        self.finished = False
         #: its speed in the last tick (m/s): the rule's on a lane, else S
         self.speed_m_s = speed_m_s
+        self._left_at_m = 0.0  # odometry distance where it left its vertex
+        #: whether the vertex it goes to is clear of its previous holder (the stations'
+        #: last word: EntryGranted, VertexClear)
+        self._ahead_clear = True
+        #: this tick's report to rule 6: it wanted to move, and the speed rule or vertex
+        #: entry held it (or it waits for its grant)
+        self._held = False
         self._handled = 0
-        self._idle_since: float | None = None
+        self._idle_since = -math.inf  # when its strategy answered idle (s)
         self._departure: float | None = None  # angle of the edge it waits to take
         self._asked: EntryRequest | None = None  # its request, until it departs
         self._asked_at_s = 0.0  # when it sent that request (s)
-        self._giving_up = False  # sent GiveUp for that request, no answer yet
         self._trips = 0  # relay missions it has set out on (rule 6)
-        self._withdrawn = False  # gave a grant back: it holds (asks again once it may go)
-        self._leaving = False  # holds the vertex it left until it is in its corridor
-        self._clear = True  # the vertex it goes to is clear of its previous holder
         self._events: list = []  # what it reports this tick (``Command.events``)
         self._said_speed = speed_m_s  # its speed as last reported
         self._held_still_s = 0.0  # how long the speed rule has held it still on its lane
         self._wait_from_m: float | None = None  # odometry distance where it began to wait
-        #: a body its front IR holds steady on its lane: since when (s) and its reading (m)
-        self._body: tuple[float, float] | None = None
-        self._pass_asked = False  # asked the stations to pass a body, not yet past it
+
+    @property
+    def finished(self) -> bool:
+        """Whether its strategy finished: declared the exploration complete, or finished
+        the part it can reach, cut off from the root (``CUT_OFF``)."""
+        return self.mode is Mode.FINISHED
+
+    @property
+    def infeasible(self) -> bool:
+        """Whether its tether declared the exploration infeasible (rule 5)."""
+        return self.mode is Mode.INFEASIBLE
+
+    def _enter(self, mode: Mode) -> None:
+        """Move to ``mode``: only along :data:`TRANSITIONS` (or to HALTED / INFEASIBLE
+        from any mode not terminal)."""
+        old = self.mode
+        if mode not in TRANSITIONS.get(old, {}) and not (
+                mode in (Mode.HALTED, Mode.INFEASIBLE) and old not in TERMINAL):
+            raise RuntimeError(f"an explorer cannot go from {old.value} to {mode.value}")
+        self.mode = mode
 
     def reset(self) -> None:
         """Put on a vertex centre (a launch): scan, then call the strategy."""
@@ -247,76 +261,72 @@ class Explorer(Controller):
         if self.table is not None:
             robots = [m for m in observation.inbox if m.sender != STATION]
             out += self.table.tick(now, robots, observation.neighbors)
-        for m in observation.inbox:
-            if m.sender == STATION:
-                self._from_station(m.payload, out, observation)
+        if self.mode not in TERMINAL:
+            for m in observation.inbox:
+                if m.sender == STATION:
+                    self._from_station(m.payload, out, observation)
         around = {}
         if self.tether is not None:
             around = {j: (d.range_m * math.cos(d.bearing_rad), d.range_m * math.sin(d.bearing_rad))
                       for j, d in observation.detections.items()}
             self._hear(now, observation, around, out)
-        if self.halted is not None or self.finished or self.infeasible:
+        if self.mode in TERMINAL:
             if self.connected is not None:
                 self.connected.retire()  # it serves as nobody's relay
             return self._stand(now, out, around)
-        if self.tether is not None and not all(q in around for q in self.tether.parents):
+        if self.leash is not None and self.leash.cut_off(around):
             command = self._retrace(now, out, around)
         else:
             command = self._drive(observation, out)
             if self.tether is None:
                 return command
-            command = self._leash(now, command, around)
-        if self.tether.stalled(now) and not self.infeasible:  # rule 5 (a robot whose
-            self.infeasible = True  # parent failed judges it too)
+            command = self._on_leash(now, command, around)
+        if self.tether.stalled(now):  # rule 5 (a robot whose parent failed judges it too)
             self._events.append(Infeasible())
+            if self.mode not in TERMINAL:
+                self._enter(Mode.INFEASIBLE)
         return command
 
+    # -- connected exploration on bodies (rules 1-6) ----------------------------------------
     def _hear(self, now: int, observation: Observation, around, out: list[Message]) -> None:
         """Its connected exploration reads the radio; what rule 6 asks of vertex entry."""
         tied = [m for m in observation.inbox if m.sender != STATION]
         # leaving a vertex (granted the next one) it adopts nobody: it would hold both
-        out += self.connected.hear(now, tied, around, willing=not self._leaving)
-        if self._withdrawn and not self.tether.children:
-            self._withdrawn = False  # free to go: ask again
+        out += self.connected.hear(now, tied, around, willing=self.mode not in HOLDS_BEHIND)
+        if self.mode is Mode.WITHDRAWN and not self.tether.children:
+            self._enter(Mode.ASKING)  # free to go: ask again
             out.append(Message(self._asked, STATION))
         if self.connected.relay_trips != self._trips:
             self._trips = self.connected.relay_trips
             self._events.append(RelayTrip())
             self._set_out(observation, out)
 
-    def _leash(self, now: int, command: Command, around) -> Command:
+    def _on_leash(self, now: int, command: Command, around) -> Command:
         """Rules 3-6 on this tick's command: it stands where the leash (or a wall it met
         on this leg) forbids its drive, then asks and beats."""
-        wanted = None
-        if command.v_m_s != 0.0:
-            step = (command.v_m_s * self.control_dt_s, 0.0)  # in its own frame
-            if self._way in self._occluded or not self.tether.may_step(step, around,
-                                                                       back=self._turning):
-                wanted, command = step, Command(messages=command.messages)
-            else:
-                self._trail.append((command.v_m_s, command.omega_rad_s))
-        if self.nav.state in (NavigatorState.SCANNING, NavigatorState.AT_VERTEX):
-            self._trail = []  # on a centre, where its beacon is: no backing out of it
-        if self.tether.parents != self._parents_then:  # a new parent: try again
-            self._occluded, self._trail, self._cut = set(), [], set()
-        self._parents_then = self.tether.parents
+        wanted = self.leash.check(command, self.control_dt_s, around,
+                                  back=self.mode in RETURNING, at_centre=self.nav.state in (
+                                      NavigatorState.SCANNING, NavigatorState.AT_VERTEX))
+        if wanted is not None:
+            command = Command(messages=command.messages)
         out = list(command.messages)
         out += self.connected.after(now, wanted, command.v_m_s != 0.0, around, self._held,
-                                    self._cut if self._way in self._occluded else ())
+                                    self.leash.cut_on_this_way(self.mode in RETURNING))
         return command._replace(messages=tuple(out))
 
     def _set_out(self, observation: Observation, out: list[Message]) -> None:
         """Rule 6: it accepted a relay mission. On an edge its plan starts with the walk
         back; on a centre where it waits for a grant it withdraws its request (the leg
         it had decided on is walked back at once: it never left) and decides anew."""
-        if self._departure is None:
-            if self.nav.state is NavigatorState.AT_VERTEX and self._idle_since is not None:
+        if self.mode not in WAITING:
+            if self.mode is Mode.IDLE:
                 self._idle_since = -math.inf  # idle: it sets out at once
             return
         if self.rule is not None:
             out.append(Message(Withdraw(), STATION))
-        self._departure, self._asked, self._withdrawn = None, None, False
+        self._departure, self._asked = None, None
         self.connected.arrived_back()
+        self._enter(Mode.DECIDING)
         # it stands where it made its last call, and reads that beacon now (the station
         # serves it to the robot it granted the vertex, or is letting leave it)
         self._vertex_call(observation.beacon, observation.time_s, False, out, back=True)
@@ -326,13 +336,11 @@ class Explorer(Controller):
         walls): drive its last moves backwards until the link is back, then wait for a new
         parent as if the leash had stopped it (on a vertex centre, at once: a robot backed
         out of the centre it scans on would scan off it, find no beacon and stop)."""
-        self._occluded.add(self._way)
-        self._cut |= {q for q in self.tether.parents if q not in around}
-        if not self._trail:
+        move = self.leash.undo(around, self.mode in RETURNING)
+        if move is None:
             return self._stand(now, out, around)
-        v, w = self._trail.pop()
         out.append(self.tether.beat(now, True, False, len(self.strategy.map_edges())))
-        return Command(-v, -w, messages=tuple(out))
+        return Command(*move, messages=tuple(out))
 
     def _stand(self, now: int, out: list[Message], around) -> Command:
         """Stand still (stopped, done, infeasible, or cut off with no move to undo); a
@@ -342,66 +350,90 @@ class Explorer(Controller):
             out.append(self.tether.beat(now, False, False, len(self.strategy.map_edges())))
         return Command(messages=tuple(out))
 
+    # -- driving ----------------------------------------------------------------------------
     def _drive(self, observation: Observation, out: list[Message]) -> Command:
         """Navigator, vertex calls, the speed rule and vertex entry: this tick's command."""
         nav, sense = self.nav, self._sense(out)
         v, w = nav.update(percept(observation.line_m, observation.ir_m,
                                   observation.encoder_rad, nav.line_filter))
         self._on_events(observation, out)
-        if self.halted is not None or self.finished:
+        if self.mode in TERMINAL:
             return Command(messages=tuple(out))
         if sense == 0:  # rule 6: a relay, or waiting to: it stands on its edge
             v = w = 0.0
         speed = self.cruise_m_s
         if self.rule is not None:
-            if nav.on_lane:  # the rule governs edge traversals
-                fired = self.rule.activations
-                speed = self._creep(self.rule.update(nav.lane_bearings(observation.bearings)),
-                                    observation.ir_m)
-                if self.rule.activations != fired:
-                    self._events.append(SpeedRuleFired(self.rule.activations - fired))
-            else:
-                self.rule.forget_bearings()
-                self._held_still_s = 0.0
+            speed = self._speed_rule(observation)
             if self._queued_too_long(observation.time_s):
-                self._giving_up = True
+                self._enter(Mode.GIVING_UP)
                 out.append(Message(GiveUp(), STATION))
-            # a vertex area it gives up is one it never backs into (``_retrace``)
-            if self._leaving and nav.in_corridor:  # clear of the vertex it left
-                out.append(Message(LeftVertex(), STATION))
-                self._leaving, self._trail = False, []
-            if self._tell_turn and nav.on_lane:  # out of the area ahead, on its way back
-                out.append(Message(TurnedBack(from_lane=True), STATION))
-                self._tell_turn, self._trail = False, []
-            # waiting for the vertex ahead (its previous holder is still leaving it), at
-            # the wall's end; one that turned back waits as soon as it follows its new
-            # lane, which may carry a robot arriving at that vertex ahead of it (one that
-            # turns back in the area it arrived at backs out of it: that area is its own)
-            if not self._clear and (nav.on_lane if self._turning else nav.at_vertex_area):
+            self._tell_stations(out)
+            back = self._wait_ahead(speed)
+            if back is not None:
                 speed = 0.0
-                if nav.on_lane and not self._turning:
-                    back = self._back_off()
-                    if back:
-                        self.speed_m_s, self._held = 0.0, True
-                        return Command(back, 0.0, messages=tuple(out))
-            else:
-                self._wait_from_m = None
-            self._stopped_body(observation, speed, out)
+                if back:
+                    self.speed_m_s, self._held = 0.0, True
+                    return Command(back, 0.0, messages=tuple(out))
+            self._watch_for_body(observation, speed, out)
         self.speed_m_s = speed
         # held: the speed rule or vertex entry stops it, or it waits for its grant
-        self._held = (v != 0.0 and speed == 0.0) or self._departure is not None
+        self._held = (v != 0.0 and speed == 0.0) or self.mode in WAITING
         if v != 0.0:  # translations run at the rule's speed; turns in place do not
             factor = speed / self.cruise_m_s
             v, w = v * factor, w * factor
         return Command(v, w, messages=tuple(out))
+
+    def _speed_rule(self, observation: Observation) -> float:
+        """Its speed (m/s) by the rule on a lane (with the creep), S elsewhere."""
+        if not self.nav.on_lane:  # the rule governs edge traversals
+            self.rule.forget_bearings()
+            self._held_still_s = 0.0
+            return self.cruise_m_s
+        fired = self.rule.activations
+        speed = self._creep(self.rule.update(self.nav.lane_bearings(observation.bearings)),
+                            observation.ir_m)
+        if self.rule.activations != fired:
+            self._events.append(SpeedRuleFired(self.rule.activations - fired))
+        return speed
+
+    def _tell_stations(self, out: list[Message]) -> None:
+        """What vertex entry owes the stations as the robot moves: LeftVertex once in its
+        corridor, TurnedBack once on its new lane after a U-turn (a vertex area it gives
+        up is one it never backs into: :meth:`_retrace`)."""
+        nav = self.nav
+        if self.mode in HOLDS_BEHIND and nav.in_corridor:  # clear of the vertex it left
+            out.append(Message(LeftVertex(), STATION))
+            self._enter(Mode.ON_LANE if self.mode is Mode.LEAVING else Mode.TURN_ASKED)
+            self._forget_trail()
+        if self.mode is Mode.WALKING_BACK_UNTOLD and nav.on_lane:  # out of the area ahead
+            out.append(Message(TurnedBack(from_lane=True), STATION))
+            self._enter(Mode.WALKING_BACK)
+            self._forget_trail()
+
+    def _forget_trail(self) -> None:
+        if self.leash is not None:
+            self.leash.forget()
+
+    def _wait_ahead(self, speed: float) -> float | None:
+        """Waiting for the vertex ahead (its previous holder is still leaving it), at
+        the wall's end: None when it need not wait, else its speed (m/s: 0, or backwards
+        while it backs off). One that turned back waits as soon as it follows its new
+        lane, which may carry a robot arriving at that vertex ahead of it (one that turns
+        back in the area it arrived at backs out of it: that area is its own)."""
+        nav, returning = self.nav, self.mode in RETURNING
+        if self._ahead_clear or not (nav.on_lane if returning else nav.at_vertex_area):
+            self._wait_from_m = None
+            return None
+        if nav.on_lane and not returning:
+            return self._back_off()
+        return 0.0
 
     def _queued_too_long(self, now_s: float) -> bool:
         """Whether it gives up its place in a queue now (:mod:`~algorithms.exploration.
         entry`, step 8): on a centre, its request ungranted for ``GIVE_UP_S``, its
         strategy able to plan round the edge. A tethered robot does not: its waits belong
         to its tether's rules."""
-        return (self._departure is not None and self._asked is not None
-                and not self._giving_up and self.connected is None and self.strategy.replans
+        return (self.mode is Mode.ASKING and self.connected is None and self.strategy.replans
                 and now_s - self._asked_at_s >= GIVE_UP_S)
 
     def _back_off(self) -> float:
@@ -414,42 +446,17 @@ class Explorer(Controller):
             return -min(CREEP_M_S, self.cruise_m_s)
         return 0.0
 
-    def _stopped_body(self, observation: Observation, speed: float,
-                      out: list[Message]) -> None:
+    def _watch_for_body(self, observation: Observation, speed: float,
+                        out: list[Message]) -> None:
         """A body that stands on its lane for good, seen with its own senses: it asks to
-        pass it (:mod:`algorithms.exploration.entry`, step 6).
-
-        The body: its front IR's reading, held within ``PASS_STEADY_M`` for
-        ``PASS_AFTER_S`` while the robot stood on its lane, and no radio
-        neighbour's ranging within 30 degrees of its nose nearer than the body's far side
-        (with radios: the body is silent; without, nothing is). It cannot tell a dead
-        robot from any other body; it needs not to: vertex entry leaves nobody else on
-        its lane (:mod:`mjswarm.experiments.stations`), so a live robot never stands on
-        it (a speed-rule stop is its own, a queue waits on vertex centres); the one live
-        exception, a relay of connected exploration, beats on its radio, and tethered
-        robots do not pass (a walk back and a pass would share the opposite lane)."""
-        if self._pass_asked:
+        pass it (:mod:`algorithms.exploration.passing`)."""
+        if self.body_watch is None:
             return
         front = observation.ir_m[1] if observation.ir_m is not None else math.nan
-        if (self.tether is not None or self.calibration.body_radius_m is None
-                or not self.nav.on_lane or speed != 0.0 or math.isnan(front)):
-            self._body = None
-            return
-        now_s = observation.time_s
-        if self._body is None or abs(front - self._body[1]) > PASS_STEADY_M:
-            self._body = (now_s, front)
-            return
-        far_m = front + 4.0 * self.calibration.body_radius_m
-        if now_s - self._body[0] >= PASS_AFTER_S and not any(
-                d.range_m < far_m and abs(d.bearing_rad) < math.radians(30.0)
-                for d in observation.detections.values()):  # no radio answers from there
-            self._pass_asked, self._body = True, (self._body[0], front)
-            out.append(Message(PassRequest(), STATION))
-
-    @property
-    def _way(self) -> int:
-        """Which way along its leg it drives: +1 on, -1 back (rule 6)."""
-        return -1 if self._turning else 1
+        asked = self.body_watch.watch(observation.time_s, front,
+                                      self.nav.on_lane and speed == 0.0, observation.detections)
+        if asked is not None:
+            out.append(Message(asked, STATION))
 
     def _sense(self, out: list[Message]) -> int:
         """Rule 6 on an edge: +1 on, 0 stand, -1 back. A walk back starts at once on its
@@ -457,13 +464,13 @@ class Explorer(Controller):
         vertex entry; nearer the vertex behind (a U-turn there would reach into its area),
         once the station gives it that vertex (if it gave it to another robot in a swap,
         it goes on, and turns farther along)."""
-        cx, nav = self.connected, self.nav
-        if cx is None or not self._on_edge:
+        cx = self.connected
+        if cx is None or self.mode not in ON_LEG:
             return 1
-        sense = cx.direction(nav.odometry.distance_m - self._left_at_m)
-        if sense < 0 and not self._turning:
+        sense = cx.direction(self.nav.odometry.distance_m - self._left_at_m)
+        if sense < 0 and self.mode not in RETURNING:
             self._walk_back(out)
-            if not self._turning:
+            if self.mode not in RETURNING:
                 return 1
         return sense
 
@@ -473,15 +480,16 @@ class Explorer(Controller):
         nav = self.nav
         if self.rule is None or nav.room_to_turn or nav.state is NavigatorState.ARRIVING:
             self._turn_back(granted=self.rule is None)
-        elif not self._turn_asked:
-            self._turn_asked = True
+        elif self.mode in (Mode.LEAVING, Mode.ON_LANE):
+            self._enter(Mode.TURN_ASKED_LEAVING if self.mode is Mode.LEAVING
+                        else Mode.TURN_ASKED)
             out.append(Message(TurnedBack(from_lane=False), STATION))
 
     def _turn_back(self, granted: bool) -> None:
         """Start the walk back (``granted``: the vertex behind is its own already)."""
         self.nav.turn_back()
-        self._turning, self._leaving, self._clear = True, False, granted
-        self._tell_turn = not granted
+        self._enter(Mode.WALKING_BACK if granted else Mode.WALKING_BACK_UNTOLD)
+        self._ahead_clear = granted
         if self.rule is not None:
             self.rule.crossed_vertex()  # a new traversal begins: eq. (34)
 
@@ -532,8 +540,8 @@ class Explorer(Controller):
             if event.kind is NavEvent.ARRIVED:
                 if self.rule is not None:
                     self.rule.crossed_vertex()  # eq. (34)
-                back, self._turning, self._on_edge = self._turning, False, False
-                self._turn_asked = False
+                back = self.mode in RETURNING
+                self._enter(Mode.DECIDING)
                 if back and self.connected is not None:
                     self.connected.arrived_back()
                 # the scan right after a launch is no arrival: the robot came by no edge;
@@ -543,11 +551,10 @@ class Explorer(Controller):
             elif event.kind is NavEvent.LOST:
                 self._halt(str(event), out)
             elif event.kind is NavEvent.PASSED:
-                self._pass_asked, self._body = False, None
-                out.append(Message(PassDone(), STATION))
-        if (self._idle_since is not None
+                out.append(Message(self.body_watch.passed(), STATION))
+        if (self.mode is Mode.IDLE
                 and observation.time_s - self._idle_since >= self.idle_wait_s):
-            self._idle_since = None
+            self._enter(Mode.DECIDING)
             self._vertex_call(observation.beacon, observation.time_s, False, out)
 
     def _vertex_call(self, beacon, now_s: float, arrived: bool, out: list[Message],
@@ -573,77 +580,94 @@ class Explorer(Controller):
         except ValueError as exc:  # a beacon it cannot reconcile (e.g. a wiped one)
             self._halt(f"its strategy failed: {exc}", out)
             return
-        consulted = cx is None or cx.consulted
-        if consulted and self.strategy.stored_angles is not None:  # re-anchoring
+        self._reanchor(beacon, cx is None or cx.consulted)
+        self.calls.append(VertexCall(now_s, beacon.id, arrived and not back, decision))
+        mapped = tuple(self.strategy.map_edges())
+        self._events.append(VertexCalled(arrived and not back, decision.action, decision.angle,
+                                         beacon.id, repr(beacon.data), mapped,
+                                         getattr(beacon.data, "matrix", None)))
+        self._decided(decision, now_s, mapped, out)
+
+    def _reanchor(self, beacon, consulted: bool) -> None:
+        """Heading re-anchoring on a beacon that stores angles; a new beacon gets its
+        dropper's frame (module docstring)."""
+        nav = self.nav
+        if consulted and self.strategy.stored_angles is not None:
             nav.reanchor(self.strategy.stored_angles, beacon.frame)
             if nav.beacon_frame is not None:
                 beacon.frame = nav.beacon_frame
         elif self.strategy.stored_angles is None and beacon.frame is None:
             # it dropped the beacon: its angles are in its own frame, as sure as its heading
             beacon.frame = (0.0, nav.heading_variance + SCAN_FRAME_VAR)
-        self.calls.append(VertexCall(now_s, beacon.id, arrived and not back, decision))
-        mapped = tuple(self.strategy.map_edges())
-        self._events.append(VertexCalled(arrived and not back, decision.action, decision.angle,
-                                         beacon.id, repr(beacon.data), mapped,
-                                         getattr(beacon.data, "matrix", None)))
+
+    def _decided(self, decision: Decision, now_s: float, mapped: tuple,
+                 out: list[Message]) -> None:
+        """The mode a decision leads to, and what it tells the stations."""
         if decision.action == "go":
-            self._departure = min(nav.edge_angles, key=lambda a: abs(
+            self._departure = min(self.nav.edge_angles, key=lambda a: abs(
                 math.remainder(a - decision.angle, 2 * math.pi)))
             if self.rule is None:
-                self._depart()
+                self._depart(Mode.ON_LANE)
             else:
+                cx = self.connected
                 self._asked = EntryRequest(decision.angle, cx is not None and cx.stops_part_way)
-                self._asked_at_s, self._giving_up = now_s, False
+                self._asked_at_s = now_s
+                self._enter(Mode.ASKING)
                 out.append(Message(self._asked, STATION))
         elif decision.action == "idle":
             self._idle_since = now_s
+            self._enter(Mode.IDLE)
         elif decision.action == "done":
-            self.finished = True
+            self._enter(Mode.FINISHED)
             self._events.append(Declared(mapped))
         elif decision.action == "cut off":  # it stands for good; VertexCalled tells
-            self.finished = True
+            self._enter(Mode.FINISHED)
             if self.rule is not None:  # a body for good on a centre: that vertex closes
                 out.append(Message(Halted("cut off from the root, its part finished"),
                                    STATION))
         else:
             raise ValueError(f"the strategy answered an unknown decision {decision!r}")
 
+    # -- the stations' answers (vertex entry, passing) --------------------------------------
     def _from_station(self, payload: Any, out: list[Message], observation: Observation) -> None:
         if isinstance(payload, EntryGranted):
-            if payload.angle_rad is not None and (
-                    self._asked is None or payload.angle_rad != self._asked.angle_rad):
-                return  # a grant its withdrawal overtook
-            self._clear = payload.clear
-            if self._turn_asked:  # it may return to the vertex it is still leaving
-                self._turn_asked = False
-                if self._turning:  # it turned in its corridor meanwhile: no lane request
-                    self._tell_turn = False
-                else:
-                    self._turn_back(granted=True)
-            elif payload.clear and self.tether is not None and self.tether.children:
-                self._withdrawn = True  # it must hold (rule 2): give the grant back
-                out.append(Message(Withdraw(), STATION))
-            elif not self._turning:  # else: the vertex it walks back to is its own now
-                self._leaving = True
-                self._depart()
+            self._granted(payload, out)
         elif isinstance(payload, VertexClear):
-            self._clear = True
+            self._ahead_clear = True
         elif isinstance(payload, PassGranted):
-            if self.nav.on_lane and self._body is not None:
-                self.nav.pass_body(self._body[1])
-            else:  # no longer where it asked (it stopped for good): the lane is free
-                self._pass_asked = False
-                out.append(Message(PassDone(), STATION))
+            done = self.body_watch.granted(self.nav.on_lane, self.nav.pass_body)
+            if done is not None:  # no longer where it asked: the lane is free
+                out.append(Message(done, STATION))
         elif isinstance(payload, EntryDenied):
             self._halt(payload.reason, out)
         elif isinstance(payload, EntryBlocked):
             self._blocked(payload, out, observation)
         elif isinstance(payload, EntryBusy):
-            if self._asked is not None and payload.angle_rad == self._asked.angle_rad:
+            if self.mode is Mode.GIVING_UP and payload.angle_rad == self._asked.angle_rad:
                 # it gave up its place: it plans anew where it stands, round that edge
                 self.strategy.give_up(payload.angle_rad)
                 self._departure, self._asked = None, None
+                self._enter(Mode.DECIDING)
                 self._vertex_call(observation.beacon, observation.time_s, False, out, back=True)
+
+    def _granted(self, payload: EntryGranted, out: list[Message]) -> None:
+        """EntryGranted: the lane it asked for (it departs, or gives a clear grant back
+        while it has children: rule 2), or the vertex behind it asked to return to."""
+        if payload.angle_rad is not None and (
+                self._asked is None or payload.angle_rad != self._asked.angle_rad):
+            return  # a grant its withdrawal overtook
+        self._ahead_clear = payload.clear
+        if self.mode in (Mode.TURN_ASKED, Mode.TURN_ASKED_LEAVING):
+            self._turn_back(granted=True)  # it may return to the vertex it is leaving
+        elif self.mode is Mode.WALKING_BACK_UNTOLD:  # it turned meanwhile: no lane request
+            self._enter(Mode.WALKING_BACK)
+        elif self.mode in WAITING:
+            if payload.clear and self.tether is not None and self.tether.children:
+                if self.mode is not Mode.WITHDRAWN:
+                    self._enter(Mode.WITHDRAWN)
+                out.append(Message(Withdraw(), STATION))  # it must hold: give it back
+            else:
+                self._depart(Mode.LEAVING)
 
     def _blocked(self, payload: EntryBlocked, out: list[Message],
                  observation: Observation) -> None:
@@ -655,37 +679,51 @@ class Explorer(Controller):
         vertex it left as rule 6's relays do (:meth:`_walk_back`; its arrival there is no
         traversal, and it decides anew); a tethered robot, whose walks back belong to its
         tether, stops for good there instead, on a lane that leads only into the closed
-        vertex. An answer its withdrawal overtook is ignored."""
-        on_way = self._departure is None
-        if on_way and not self._on_edge:
+        vertex. One whose way back closed (the vertex it walks back to, or asked for) stops
+        for good. An answer its withdrawal overtook is ignored."""
+        if self.mode in ON_LEG:
+            if self.connected is not None:
+                self._halt("the vertex it was granted closed (a body stopped in its area)", out)
+            elif self.mode in RETURNING or payload.angle_rad is None:
+                self._halt("the vertex it walks back to closed (a body stopped in its "
+                           "area)", out)
+            elif self._block(payload.angle_rad, out):
+                self._walk_back(out)
             return
-        if on_way and self.connected is not None:
-            self._halt("the vertex it was granted closed (a body stopped in its area)", out)
+        if self.mode not in WAITING or payload.angle_rad != self._asked.angle_rad:
             return
-        if not on_way and (self._asked is None or payload.angle_rad != self._asked.angle_rad):
+        if not self._block(payload.angle_rad, out):
             return
-        try:
-            self.strategy.block(payload.angle_rad)
-        except NotImplementedError as exc:
-            self._halt(str(exc), out)
-            return
-        if on_way:
-            self._walk_back(out)
-            return
-        self._departure, self._asked, self._withdrawn = None, None, False
+        self._departure, self._asked = None, None
         if self.connected is not None:
             self.connected.arrived_back()  # it never left: its leg is undone
+        self._enter(Mode.DECIDING)
         self._vertex_call(observation.beacon, observation.time_s, False, out, back=True)
 
-    def _depart(self) -> None:
+    def _block(self, angle_rad: float, out: list[Message]) -> bool:
+        """Tell its strategy the edge at ``angle_rad`` is blocked; False if it cannot (it
+        stops for good)."""
+        try:
+            self.strategy.block(angle_rad)
+        except NotImplementedError as exc:
+            self._halt(str(exc), out)
+            return False
+        return True
+
+    def _depart(self, mode: Mode) -> None:
+        """Leave along ``_departure``: LEAVING (granted: it holds the vertex it leaves
+        until in its corridor) or ON_LANE (without vertex entry)."""
         self.nav.depart(self._departure)
         self._departure, self._asked = None, None
-        self._on_edge, self._left_at_m = True, self.nav.odometry.distance_m
-        self._occluded, self._trail, self._cut = set(), [], set()  # a new leg: new walls
+        self._left_at_m = self.nav.odometry.distance_m
+        self._enter(mode)
+        if self.leash is not None:
+            self.leash.new_leg()  # a new leg: new walls
 
     def _halt(self, reason: str, out: list[Message]) -> None:
-        if self.halted is None:
+        if self.mode not in TERMINAL:
             self.halted = reason
+            self._enter(Mode.HALTED)
             self._events.append(Stopped(reason))
             if self.rule is not None:
                 out.append(Message(Halted(reason), STATION))

@@ -94,14 +94,12 @@ from algorithms.exploration.entry import (
     GiveUp,
     Halted,
     LeftVertex,
-    PassDone,
-    PassGranted,
-    PassRequest,
     TurnedBack,
     VertexClear,
     Withdraw,
 )
 from algorithms.exploration.events import VertexCalled
+from algorithms.exploration.passing import PassDone, PassGranted, PassLanes, PassRequest
 from mjswarm.arena import ArenaSpec
 from mjswarm.arena.geometry import VERTEX_CLEAR_RADIUS_M, junction_depths, vertex_fans
 from mjswarm.worlds.loop import Loop, LoopFunctions
@@ -130,10 +128,8 @@ class VertexStations:
         self._fans = vertex_fans(spec)
         self.holder: dict[str, int] = {}
         self.requests: dict[int, Request] = {}
-        #: lanes held for a pass (:mod:`algorithms.exploration.entry`, step 6): robot ->
-        #: (from, to), the lane's ends in its direction of travel; nobody is granted ``to``
-        #: from ``from`` meanwhile
-        self.passes: dict[int, tuple[str, str]] = {}
+        #: lanes held for a pass (:mod:`algorithms.exploration.passing`)
+        self.lanes = PassLanes()
 
     def edge_towards(self, vertex: str, angle: float) -> tuple[str, float]:
         """The neighbour of ``vertex`` along the edge nearest to ``angle`` (rad, common
@@ -178,7 +174,7 @@ class VertexStations:
     def release_all(self, robot: int) -> list[str]:
         """``robot`` stopped for good: drop its request and every hold; returns the vertices."""
         self.requests.pop(robot, None)
-        self.passes.pop(robot, None)
+        self.lanes.done(robot)
         held = [v for v, r in self.holder.items() if r == robot]
         for v in held:
             del self.holder[v]
@@ -187,7 +183,7 @@ class VertexStations:
     def _on_held_lane(self, robot: int) -> bool:
         """Whether ``robot``'s request would take it along a lane held for a pass."""
         request = self.requests[robot]
-        return (request.at, request.to) in self.passes.values()
+        return self.lanes.holds(request.at, request.to)
 
     def _queue(self) -> list[int]:
         return sorted(self.requests, key=lambda r: (self.requests[r].since_s, r))
@@ -287,8 +283,6 @@ class StationService(LoopFunctions):
         self.asked: list[float | None] = [None] * k
         #: robots granted a vertex whose previous holder has not yet left it
         self.awaiting_clear: set[int] = set()
-        #: robots that asked to pass a body and have not yet been told to
-        self.pass_waiting: set[int] = set()
         #: closed vertices (module docstring): vertex -> (robot whose body closed it, time s)
         self.closed: dict[str, tuple[int, float]] = {}
         #: robots on their way to a vertex that closed, to be told once out of every area
@@ -344,11 +338,9 @@ class StationService(LoopFunctions):
                 self.awaiting_clear.add(i)
             self.uplink.reply(i, EntryGranted(clear, self.asked[i]))
             loop.event(f"R{i + 1} granted {vertex}", i)
-        for i in sorted(self.pass_waiting):
-            if not self._on_the_way(*self.stations.passes[i]):
-                self.pass_waiting.discard(i)
-                self.uplink.reply(i, PassGranted())
-                loop.event(f"R{i + 1} passes a body", i)
+        for i in self.stations.lanes.ready(self._on_the_way):
+            self.uplink.reply(i, PassGranted())
+            loop.event(f"R{i + 1} passes a body", i)
 
     def after_step(self, loop: Loop) -> None:
         """Without vertex entry, a robot's vertex is the one its decision leads to."""
@@ -381,11 +373,9 @@ class StationService(LoopFunctions):
             self._release(i)
         elif isinstance(payload, PassRequest):
             # the opposite lane leads from the vertex ahead back to the one it left
-            self.stations.passes[i] = (self.target[i], self.came_from[i])
-            self.pass_waiting.add(i)
+            self.stations.lanes.request(i, self.target[i], self.came_from[i])
         elif isinstance(payload, PassDone):
-            self.stations.passes.pop(i, None)
-            self.pass_waiting.discard(i)
+            self.stations.lanes.done(i)
 
     def _on_the_way(self, start: str, end: str) -> bool:
         """Whether some robot is on the lane from ``start`` to ``end``: it was granted
@@ -462,7 +452,6 @@ class StationService(LoopFunctions):
         vertex, distance = self.nearest(i)
         self.leaving[i] = None
         self.awaiting_clear.discard(i)
-        self.pass_waiting.discard(i)
         if distance < VERTEX_CLEAR_RADIUS_M or distance < self._junction_depth(i, vertex):
             self.stations.occupy(i, vertex)
             self._close(vertex, i)

@@ -1,0 +1,83 @@
+"""Connected exploration's leash on a body (ours): the moves a MuJoCo robot may make on
+its tether, and the walls its leash cannot know.
+
+The tether (:class:`~algorithms.exploration.tether.Tether`) knows ranges, not walls. A
+robot keeps the moves it made since its parents were last all in radio reach (its
+*trail*); when a wall comes between it and a parent (the link is gone from its radio
+neighbours) it drives them backwards until the link is back, never back into a vertex
+area it has given up (the trail is forgotten when it tells the stations it left one),
+nor off a vertex centre it reached (forgotten there too). The way along its leg in which
+the wall cut a link (+1 on, -1 back) is then closed to it for the rest of the leg, or
+until it has a new parent: it stands there as if the leash had stopped it (so it calls a
+relay, rule 6), and may still walk back along its leg unless a wall cut a link on the
+way back too.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from algorithms.exploration.tether import Tether
+from algorithms.robot import Command
+
+
+class Leash:
+    """One robot's leash on its body (module docstring)."""
+
+    def __init__(self, tether: Tether) -> None:
+        self.tether = tether
+        self._trail: list[tuple[float, float]] = []  # (v m/s, omega rad/s) since all linked
+        self._occluded: set[int] = set()  # the ways (+1 on, -1 back) a wall cut a link
+        self._cut: set = set()  # the parents whose links a wall cut
+        self._parents_then = tether.parents
+
+    @staticmethod
+    def _way(back: bool) -> int:
+        return -1 if back else 1
+
+    def cut_off(self, around: Mapping) -> bool:
+        """Whether a parent is missing from its radio neighbours ``around``."""
+        return not all(q in around for q in self.tether.parents)
+
+    def check(self, command: Command, dt_s: float, around: Mapping, back: bool,
+              at_centre: bool) -> tuple[float, float] | None:
+        """The step (m, its own frame) the leash, or a wall met on this way, forbids of
+        ``command`` this control period (``dt_s``), or None: the command may go (and
+        joins the trail). ``back``: it walks back along its leg; ``at_centre``: it stands
+        on a vertex centre, where nothing is backed out of."""
+        wanted = None
+        if command.v_m_s != 0.0:
+            step = (command.v_m_s * dt_s, 0.0)
+            if self._way(back) in self._occluded or not self.tether.may_step(
+                    step, around, back=back):
+                wanted = step
+            else:
+                self._trail.append((command.v_m_s, command.omega_rad_s))
+        if at_centre:
+            self._trail = []
+        if self.tether.parents != self._parents_then:  # a new parent: try again
+            self.new_leg()
+        self._parents_then = self.tether.parents
+        return wanted
+
+    def cut_on_this_way(self, back: bool):
+        """The parents a wall cut it from on the way it drives (empty if none)."""
+        return self._cut if self._way(back) in self._occluded else ()
+
+    def undo(self, around: Mapping, back: bool) -> tuple[float, float] | None:
+        """A parent's link is gone: this way is closed, and the last move of its trail
+        reversed (``(v m/s, omega rad/s)``), or None when nothing is left to undo."""
+        self._occluded.add(self._way(back))
+        self._cut |= {q for q in self.tether.parents if q not in around}
+        if not self._trail:
+            return None
+        v, w = self._trail.pop()
+        return -v, -w
+
+    def forget(self) -> None:
+        """Forget its trail (it gave up a vertex area: it never backs into it)."""
+        self._trail = []
+
+    def new_leg(self) -> None:
+        """A new leg, or a new parent: no walls known, nothing to undo."""
+        self._occluded, self._trail, self._cut = set(), [], set()
