@@ -4,8 +4,9 @@
   argparse parsers themselves, so the page cannot drift from the command line;
 - ``reference/api/*.md``: one page per package, each module rendered by mkdocstrings
   from its docstrings;
-- ``reference/explorer-modes.md``: the embodied explorer's modes and every move between
-  them, from :data:`algorithms.exploration.modes.TRANSITIONS`;
+- ``reference/state-machines.md``: the embodied explorer's modes and its navigator's
+  states, with every move between them, from :data:`algorithms.exploration.modes.
+  TRANSITIONS` and :data:`algorithms.navigation.navigator.NAVIGATOR_TRANSITIONS`;
 - ``changelog.md``: the repository's ``CHANGELOG.md``.
 """
 
@@ -19,6 +20,7 @@ from pathlib import Path
 import mkdocs_gen_files
 
 from algorithms.exploration.modes import TRANSITIONS, Mode
+from algorithms.navigation.navigator import NAVIGATOR_TRANSITIONS
 from mjswarm.cli import build_parser
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -70,22 +72,31 @@ def api_page(title: str, packages: tuple[str, ...]) -> str:
     return "\n".join(lines)
 
 
-def modes_page() -> str:
-    """The explorer's modes and its transition table, as the code holds them."""
-    lines = ["# The explorer's modes", "",
-             "Generated from `algorithms.exploration.modes` when the site is built. "
-             "Every mode that is not terminal may also end in `halted` (it stops for good) "
-             "or `infeasible` (its tether's stall verdict, rule 5).", "",
-             "| mode | what it does |", "|---|---|"]
-    lines += [f"| `{m.name}` | {m.value} |" for m in Mode]
-    lines += ["", "| from | to | when |", "|---|---|---|"]
-    for source, targets in TRANSITIONS.items():
+def moves(table: dict) -> list[str]:
+    """A transition table as markdown rows: from, to, when."""
+    lines = ["| from | to | when |", "|---|---|---|"]
+    for source, targets in table.items():
         lines += [f"| `{source.name}` | `{target.name}` | {why} |"
                   for target, why in targets.items()]
+    return lines
+
+
+def modes_page() -> str:
+    """The explorer's modes and the navigator's states, as the code holds them."""
+    lines = ["# State machines", "",
+             "Generated from `algorithms.exploration.modes` and "
+             "`algorithms.navigation.navigator` when the site is built.", "",
+             "## The explorer's modes", "",
+             "Every mode that is not terminal may also end in `HALTED` (it stops for good) "
+             "or `INFEASIBLE` (its tether's stall verdict, rule 5).", "",
+             "| mode | what it does |", "|---|---|"]
+    lines += [f"| `{m.name}` | {m.value} |" for m in Mode]
+    lines += ["", *moves(TRANSITIONS), "", "## The navigator's states", "",
+              *moves(NAVIGATOR_TRANSITIONS)]
     return "\n".join(lines) + "\n"
 
 
-with mkdocs_gen_files.open("reference/explorer-modes.md", "w") as page:
+with mkdocs_gen_files.open("reference/state-machines.md", "w") as page:
     page.write(modes_page())
 with mkdocs_gen_files.open("reference/cli.md", "w") as page:
     page.write(cli_page())

@@ -121,13 +121,69 @@ class NavigatorEvent:
 
 
 class NavigatorState(Enum):
+    """What a navigator's body is doing; :data:`NAVIGATOR_TRANSITIONS` lists every move."""
+
     SCANNING = "scanning"
     AT_VERTEX = "at_vertex"  # edges known, waiting for depart()
     LEAVING = "leaving"
     ON_EDGE = "on_edge"
     ARRIVING = "arriving"
+    STEPPING_ACROSS = "stepping_across"  # passing a body: square across between the lanes
     PASSING = "passing"  # round a body on its lane, on the opposite lane
     LOST = "lost"  # lost its line: needs help (the paper's robots were placed back by hand)
+
+
+#: Every move of a navigator's state, with what makes it.
+NAVIGATOR_TRANSITIONS: dict[NavigatorState, dict[NavigatorState, str]] = {
+    NavigatorState.AT_VERTEX: {
+        NavigatorState.SCANNING: "begin_at_vertex() (a launch)",
+        NavigatorState.LEAVING: "depart()"},
+    NavigatorState.SCANNING: {NavigatorState.AT_VERTEX: "the turn is complete"},
+    NavigatorState.LEAVING: {
+        NavigatorState.ON_EDGE: "a sensor finds its own lane",
+        NavigatorState.ARRIVING: "turn_back() short of its corridor",
+        NavigatorState.LOST: "no lane strip ahead"},
+    NavigatorState.ON_EDGE: {
+        NavigatorState.ARRIVING: "the lane ends after its wall; turn_back() short of "
+                                 "its corridor",
+        NavigatorState.LEAVING: "turn_back() in its corridor: a U-turn",
+        NavigatorState.STEPPING_ACROSS: "pass_body()",
+        NavigatorState.LOST: "the lane ends with the wall beside it, or before any wall"},
+    NavigatorState.ARRIVING: {
+        NavigatorState.SCANNING: "on the vertex centre",
+        NavigatorState.LEAVING: "turn_back(): back to where its lane ended, a U-turn",
+        NavigatorState.LOST: "no spoke at the vertex"},
+    NavigatorState.STEPPING_ACROSS: {
+        NavigatorState.PASSING: "on the opposite lane",
+        NavigatorState.ON_EDGE: "back on its own lane, past the body",
+        NavigatorState.LOST: "no opposite lane, or its own lane not found again"},
+    NavigatorState.PASSING: {
+        NavigatorState.STEPPING_ACROSS: "a body diameter past the body",
+        NavigatorState.ARRIVING: "the corridor ended during the pass",
+        NavigatorState.LOST: "the opposite lane ended beside the body"},
+    NavigatorState.LOST: {},
+}
+
+
+#: The states in which a robot follows one of its edge's lanes (or steps between them).
+ON_A_LANE = frozenset({NavigatorState.ON_EDGE, NavigatorState.STEPPING_ACROSS,
+                       NavigatorState.PASSING})
+
+
+class Corridor(Enum):
+    """How far along its corridor a robot on a lane is (vertex detection by its IR)."""
+
+    BEFORE_WALL = "before its wall"
+    BESIDE_WALL = "beside its wall"  # seen for ``min_wall_run_m``: in its corridor
+    VERTEX_AHEAD = "vertex ahead"  # the wall, once seen, ended
+
+
+class Leg(Enum):
+    """Which way a robot travels its edge: out to the vertex ahead, or back to the one
+    it left (:meth:`Navigator.turn_back`)."""
+
+    OUT = "out"
+    BACK = "back"
 
 
 class Navigator:
@@ -154,6 +210,7 @@ class Navigator:
         self.speed = speed_m_s
         self._approach_speed = min(speed_m_s, APPROACH_SPEED_M_S)
         self.turn_rate = turn_rate_rad_s
+        #: what its body is doing (:data:`NAVIGATOR_TRANSITIONS`)
         self.state = NavigatorState.AT_VERTEX
         self.edge_angles: list[float] = []
         self.arrived_angle: float | None = None
@@ -175,15 +232,25 @@ class Navigator:
         self._left: tuple[float, float, float] | None = None  # centre x, y and angle it left by
         #: x, y and heading (odometry) where its lane ended
         self._lane_end: tuple[float, float, float] | None = None
-        self._returning = False  # turned back: on its way to the vertex it left
+        self.leg = Leg.OUT
         self._wall_run_start: float | None = None
-        self._wall_seen = False
+        self.corridor = Corridor.BEFORE_WALL
         self._wall_first_m: float | None = None  # odometry distance where its wall began
-        self.vertex_detected = False
         #: which side of its lane the edge's centre line lies: -1 right (its own lane),
         #: +1 left (the opposite lane, passing a body)
         self._centre_side = -1
-        self._watching = True  # watching the corridor wall (not while sidestepping)
+
+    def _enter(self, state: NavigatorState) -> None:
+        """Move to ``state``: only along :data:`NAVIGATOR_TRANSITIONS`."""
+        if state not in NAVIGATOR_TRANSITIONS[self.state]:
+            raise RuntimeError(f"a navigator cannot go from {self.state.value} to "
+                               f"{state.value}")
+        self.state = state
+
+    @property
+    def vertex_detected(self) -> bool:
+        """Whether its corridor wall, once seen, has ended: the vertex is ahead."""
+        return self.corridor is Corridor.VERTEX_AHEAD
 
     # ---------------------------------------------------------------- control
     def begin_at_vertex(self) -> None:
@@ -200,7 +267,7 @@ class Navigator:
              self._found_lane),
         ])
         self._left = (self.odometry.x, self.odometry.y, angle)
-        self.state = NavigatorState.LEAVING
+        self._enter(NavigatorState.LEAVING)
         self.events.append(NavigatorEvent(NavEvent.LEFT_VERTEX))
 
     def turn_back(self) -> None:
@@ -220,7 +287,7 @@ class Navigator:
                               NavigatorState.ARRIVING):
             raise RuntimeError(f"turn_back() needs the robot on an edge, it is {self.state.value}")
         x, y, angle = self._left
-        self._incoming, self._returning = angle, True
+        self._incoming, self.leg = angle, Leg.BACK
         odo = self.odometry
         if self.in_corridor or self.state is NavigatorState.ARRIVING:
             plan = []
@@ -239,7 +306,7 @@ class Navigator:
                 *self._shift(back, +1, 2.0 * self.conv.lane_offset_m),
                 (SeekLine(back, self.speed, self.conv.max_seek_m), self._found_lane),
             ])
-            self.state = NavigatorState.LEAVING
+            self._enter(NavigatorState.LEAVING)
             return
         # to the outer end of the spoke it left by, then in along it as on any arrival
         out = self.conv.spoke_radius_m + self.cal.line_ahead_m
@@ -252,7 +319,7 @@ class Navigator:
             (SeekLine(inward, self._approach_speed, self.conv.max_seek_m), self._found_spoke),
             (FollowSpoke(self._approach_speed), self._spoke_ended),
         ])
-        self.state = NavigatorState.ARRIVING
+        self._enter(NavigatorState.ARRIVING)
 
     def pass_body(self, ahead_m: float) -> None:
         """Pass a body standing ``ahead_m`` (m, the front IR's reading from its rim) ahead
@@ -274,7 +341,7 @@ class Navigator:
             (SeekLine(heading, self.speed, self.conv.max_seek_m), self._found_opposite),
             (follow, self._passed),
         ])
-        self.state, self._watching = NavigatorState.PASSING, False
+        self._enter(NavigatorState.STEPPING_ACROSS)
 
     def _sidestep(self, heading: float, side: int) -> list:
         """Cross to the other lane of its edge, to the left (side=+1) or right (-1) of
@@ -288,7 +355,7 @@ class Navigator:
         self.odometry.update(percept.encoders)
         if self.state is NavigatorState.ON_EDGE:
             self._watch_wall(percept.ir[0])
-        elif self.state is NavigatorState.PASSING and self._watching:
+        elif self.state is NavigatorState.PASSING:
             self._watch_wall(percept.ir[2])  # the corridor's other wall, seen from its lane
         while self._plan:
             motion, on_done = self._plan[0]
@@ -347,8 +414,7 @@ class Navigator:
     def in_corridor(self) -> bool:
         """On an edge's lane (or passing on the opposite one) and has seen its corridor
         wall (``min_wall_run_m`` of it)."""
-        return (self.state in (NavigatorState.ON_EDGE, NavigatorState.PASSING)
-                and self._wall_seen)
+        return self.state in ON_A_LANE and self.corridor is not Corridor.BEFORE_WALL
 
     @property
     def room_to_turn(self) -> bool:
@@ -453,8 +519,8 @@ class Navigator:
     def at_vertex_area(self) -> bool:
         """About to enter a vertex area: on the lane with the vertex detected (the left
         wall has ended), or already arriving."""
-        return ((self.state in (NavigatorState.ON_EDGE, NavigatorState.PASSING)
-                 and self.vertex_detected) or self.state is NavigatorState.ARRIVING)
+        return ((self.state in ON_A_LANE and self.vertex_detected)
+                or self.state is NavigatorState.ARRIVING)
 
     # ---------------------------------------------------------------- plans
     def _shift(self, heading: float, side: int, distance_m: float | None = None,
@@ -473,9 +539,8 @@ class Navigator:
         if seek.failed:
             self._lose("no lane strip ahead after leaving the vertex")
             return
-        self.state = NavigatorState.ON_EDGE
-        self.vertex_detected = False
-        self._wall_seen = False
+        self._enter(NavigatorState.ON_EDGE)
+        self.corridor = Corridor.BEFORE_WALL
         self._wall_run_start = None
         self._wall_first_m = None
         self._lane = FollowLine(self.speed)
@@ -485,13 +550,14 @@ class Navigator:
         if seek.failed:
             self._lose("no opposite lane beside the body it passes")
             return
-        self._watching, self._wall_run_start = True, None
+        self._enter(NavigatorState.PASSING)
+        self._wall_run_start = None
 
     def _passed(self, follow: FollowLineAlong) -> None:
         """Past the body: back onto its own lane, or (the corridor ended meanwhile) on
         along the opposite lane to its end and the arrival from there."""
         if follow.reached and not self.vertex_detected:
-            self._watching = False
+            self._enter(NavigatorState.STEPPING_ACROSS)
             self._plan = deque([
                 *self._sidestep(follow.heading, +1),
                 (SeekLine(follow.heading, self.speed, self.conv.max_seek_m), self._rejoined),
@@ -527,7 +593,8 @@ class Navigator:
         if seek.failed:
             self._lose("its lane not found after passing a body")
             return
-        self.state, self._watching, self._wall_run_start = NavigatorState.ON_EDGE, True, None
+        self._enter(NavigatorState.ON_EDGE)
+        self._wall_run_start = None
         self._lane = FollowLine(self.speed)
         self._plan = deque([(self._lane, self._lane_ended)])
         self.events.append(NavigatorEvent(NavEvent.PASSED))
@@ -549,13 +616,14 @@ class Navigator:
                 self._wall_first_m = travelled
             # a robot that turned back may have little wall left beside it (a U-turn at
             # the far end of a short edge): any of it will do
-            run = 0.0 if self._returning else self.conv.min_wall_run_m
-            if travelled - self._wall_run_start >= run:
-                self._wall_seen = True
+            run = 0.0 if self.leg is Leg.BACK else self.conv.min_wall_run_m
+            if (travelled - self._wall_run_start >= run
+                    and self.corridor is Corridor.BEFORE_WALL):
+                self.corridor = Corridor.BESIDE_WALL
         else:
             self._wall_run_start = None
-            if self._wall_seen and not self.vertex_detected:
-                self.vertex_detected = True
+            if self.corridor is Corridor.BESIDE_WALL:
+                self.corridor = Corridor.VERTEX_AHEAD
                 self.events.append(NavigatorEvent(NavEvent.VERTEX_DETECTED))
 
     def _lane_ended(self, lane: FollowLine, clear_m: float = 0.0) -> None:
@@ -565,11 +633,12 @@ class Navigator:
         centre line square to the lane, since the diagonal shift's turn toward the body's
         side would touch it (``arena2`` with 4 robots, seed 0, ``robot:1@91``: 23 contact
         events before)."""
-        if not self.vertex_detected and not self._returning:
-            self._lose("lane ended with the wall still beside the robot" if self._wall_seen
+        if not self.vertex_detected and self.leg is Leg.OUT:
+            self._lose("lane ended with the wall still beside the robot"
+                       if self.corridor is Corridor.BESIDE_WALL
                        else "lane ended before any corridor wall was seen (not its lane?)")
             return
-        self.state, self._watching = NavigatorState.ARRIVING, True
+        self._enter(NavigatorState.ARRIVING)
         heading = lane.direction(self.odometry.theta, last=None)
         self._lane_end = (self.odometry.x, self.odometry.y, heading)
         # the lane's direction in the odometry frame, carried to the scan: the incoming
@@ -600,7 +669,7 @@ class Navigator:
                            lambda _: self._start_scan()))
 
     def _start_scan(self) -> None:
-        self.state = NavigatorState.SCANNING
+        self._enter(NavigatorState.SCANNING)
         self._scans += 1
         direction = 1 if self._scans % 2 else -1  # alternate: see the module docstring
         width = self._spoke_width
@@ -634,12 +703,12 @@ class Navigator:
             self.arrived_angle = self._incoming
             self.edge_angles = off_centre_correction(
                 angles, self.arrived_angle, self.cal.line_ahead_m)
-        self.state = NavigatorState.AT_VERTEX
-        self._returning = False
+        self._enter(NavigatorState.AT_VERTEX)
+        self.leg = Leg.OUT
         self.events.append(NavigatorEvent(NavEvent.ARRIVED))
 
     def _lose(self, why: str) -> None:
-        self.state = NavigatorState.LOST
+        self._enter(NavigatorState.LOST)
         self._plan.clear()
         self.events.append(NavigatorEvent(NavEvent.LOST, why))
 

@@ -1,0 +1,165 @@
+"""The navigator's states: every move of :data:`~algorithms.navigation.navigator.
+NAVIGATOR_TRANSITIONS` driven by what ends its motions (a seek that finds its line or
+fails, a scan, the lane's end, the corridor wall seen and gone, a pass's follow) and by
+its commands (``depart``, ``turn_back``, ``pass_body``), and no move outside the table.
+The MuJoCo runs of ``tests/test_navigation.py`` and ``tests/test_passing.py`` drive the
+same moves with real sensors."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import pytest
+
+from algorithms.navigation import NavigatorState
+from algorithms.navigation.navigator import NAVIGATOR_TRANSITIONS, Corridor, Leg, Navigator
+from mjswarm.core.simulation import Simulation
+from mjswarm.core.world import Pose2D, world_spec
+from mjswarm.worlds.navigation import calibration, conventions
+
+S = NavigatorState
+FOUND, FAILED = SimpleNamespace(failed=False), SimpleNamespace(failed=True)
+
+
+@pytest.fixture(scope="module")
+def body():
+    geometry = Simulation(world_spec([Pose2D(0.0, 0.0)])).geometry
+    return calibration(geometry), conventions(geometry)
+
+
+class Driven:
+    """A navigator whose moves are recorded."""
+
+    def __init__(self, body) -> None:
+        self.nav = Navigator(*body, 0.0, 0.1)
+        self.moves: list[tuple[S, S]] = []
+        enter = self.nav._enter
+
+        def recorded(state: S) -> None:
+            self.moves.append((self.nav.state, state))
+            enter(state)
+        self.nav._enter = recorded
+
+    def at_vertex(self) -> Navigator:
+        nav = self.nav
+        nav.begin_at_vertex()
+        nav._scanned(SimpleNamespace(full_turn=None, start=0.0, swept=2 * math.pi,
+                                     mids=[0.0, math.pi]))
+        assert nav.state is S.AT_VERTEX and nav.edge_angles == [0.0, math.pi]
+        return nav
+
+    def on_lane(self) -> Navigator:
+        nav = self.at_vertex()
+        nav.depart(0.0)
+        nav._found_lane(FOUND)
+        assert nav.state is S.ON_EDGE and nav.corridor is Corridor.BEFORE_WALL
+        return nav
+
+    def in_corridor(self) -> Navigator:
+        nav = self.on_lane()
+        wall = nav.conv.wall_distance_m
+        for _ in range(3):
+            nav._watch_wall(wall)
+            nav.odometry.distance_m += nav.conv.min_wall_run_m
+        assert nav.corridor is Corridor.BESIDE_WALL and nav.in_corridor
+        return nav
+
+    def vertex_ahead(self) -> Navigator:
+        nav = self.in_corridor()
+        for _ in range(10):
+            nav._watch_wall(math.nan)
+        assert nav.vertex_detected and nav.at_vertex_area
+        return nav
+
+    def arriving(self) -> Navigator:
+        nav = self.vertex_ahead()
+        nav._lane_ended(nav._lane)
+        assert nav.state is S.ARRIVING
+        return nav
+
+    def passing(self) -> Navigator:
+        nav = self.in_corridor()
+        nav.pass_body(0.05)
+        assert nav.state is S.STEPPING_ACROSS and not nav.on_lane and nav.in_corridor
+        nav._found_opposite(FOUND)
+        assert nav.state is S.PASSING
+        return nav
+
+
+def scenarios(body) -> list[Driven]:
+    """Drive each move once; return the navigators (their recorded moves)."""
+    made = []
+
+    def drive() -> Driven:
+        made.append(Driven(body))
+        return made[-1]
+
+    nav = drive().arriving()
+    nav._start_scan()  # on the centre: the arrival's scan
+    assert nav.state is S.SCANNING
+    assert drive().arriving().turn_back() is None  # back to the lane's end, a U-turn
+    assert made[-1].nav.state is S.LEAVING and made[-1].nav.leg is Leg.BACK
+    nav = drive().arriving()
+    nav._found_spoke(FAILED)
+    assert nav.state is S.LOST
+    nav = drive().at_vertex()
+    nav.depart(0.0)
+    nav.turn_back()  # short of its corridor: by odometry to the spoke it left by
+    assert nav.state is S.ARRIVING
+    nav = drive().at_vertex()
+    nav.depart(0.0)
+    nav._found_lane(FAILED)
+    assert nav.state is S.LOST
+    nav = drive().on_lane()
+    nav.turn_back()
+    assert nav.state is S.ARRIVING
+    nav = drive().in_corridor()
+    nav.turn_back()  # a U-turn onto the opposite lane
+    assert nav.state is S.LEAVING
+    nav = drive().on_lane()
+    nav._lane_ended(nav._lane)  # no wall seen: not its lane
+    assert nav.state is S.LOST and "before any corridor wall" in nav.events[-1].reason
+    nav = drive().passing()
+    nav._passed(SimpleNamespace(reached=True, heading=0.0))
+    assert nav.state is S.STEPPING_ACROSS
+    nav._rejoined(FOUND)
+    assert nav.state is S.ON_EDGE
+    nav = drive().passing()
+    nav._passed(SimpleNamespace(reached=True, heading=0.0))
+    nav._rejoined(FAILED)
+    assert nav.state is S.LOST
+    nav = drive().in_corridor()
+    nav.pass_body(0.05)
+    nav._found_opposite(FAILED)
+    assert nav.state is S.LOST
+    nav = drive().passing()
+    nav._passed(SimpleNamespace(reached=False, heading=0.0))  # the lane ended beside it
+    assert nav.state is S.LOST
+    nav = drive().passing()
+    for _ in range(10):
+        nav._watch_wall(math.nan)  # the corridor ends during the pass
+    nav._lane_ended(nav._lane)
+    assert nav.state is S.ARRIVING
+    return made
+
+
+def test_every_move_of_the_table_is_driven(body):
+    driven = set().union(*(set(d.moves) for d in scenarios(body)))
+    table = {(a, b) for a, targets in NAVIGATOR_TRANSITIONS.items() for b in targets}
+    assert table - driven == set()
+    assert driven - table == set()
+
+
+def test_moves_outside_the_table_are_refused(body):
+    nav = Navigator(*body, 0.0, 0.1)
+    with pytest.raises(RuntimeError, match="needs the robot on an edge"):
+        nav.turn_back()
+    with pytest.raises(RuntimeError, match="cannot go from at_vertex to passing"):
+        nav._enter(S.PASSING)
+    nav.begin_at_vertex()
+    nav._scanned(SimpleNamespace(full_turn=None, start=0.0, swept=2 * math.pi, mids=[0.0]))
+    nav.depart(0.0)
+    nav._found_lane(FAILED)
+    with pytest.raises(RuntimeError, match="cannot go from lost to scanning"):
+        nav.begin_at_vertex()
