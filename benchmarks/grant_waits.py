@@ -20,13 +20,14 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 import numpy as np  # noqa: E402
 
 from mjswarm.cli import main  # noqa: E402
+from algorithms.exploration import entry  # noqa: E402
 from mjswarm.experiments import stations  # noqa: E402
 
 
 def record_waits() -> list[float]:
     """Patch the stations so that every grant from a centre appends its wait (s)."""
     waits: list[float] = []
-    grant, before_step = stations.VertexStations.grant, stations.StationService.before_step
+    grant, before_step = entry.VertexStations.grant, stations.StationService.before_step
     clock = {"now_s": 0.0}
 
     def timed_before_step(self, loop):
@@ -41,7 +42,7 @@ def record_waits() -> list[float]:
         return granted
 
     stations.StationService.before_step = timed_before_step
-    stations.VertexStations.grant = timed_grant
+    entry.VertexStations.grant = timed_grant
     return waits
 
 

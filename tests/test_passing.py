@@ -10,21 +10,21 @@ import math
 import pytest
 
 from algorithms.collision import CollisionRule
-from algorithms.exploration.entry import STATION
+from algorithms.exploration.entry import STATION, VertexStations
 from algorithms.exploration.passing import PASS_AFTER_S, PASS_STEADY_M, PassRequest
 from algorithms.exploration.explorer import Explorer
 from algorithms.navigation import NavEvent, Navigator, NavigatorState
 from algorithms.navigation.navigator import PASS_MARGIN_M
 from algorithms.robot import Detection, Observation
 from mjswarm.arena import load_arena
-from mjswarm.arena.geometry import LANE_OFFSET_M, SPOKE_INNER_RADIUS_M, VERTEX_CLEAR_RADIUS_M
+from mjswarm.arena.geometry import (LANE_OFFSET_M, SPOKE_INNER_RADIUS_M, VERTEX_CLEAR_RADIUS_M,
+                                    vertex_fans)
 from mjswarm.core.simulation import Simulation
 from mjswarm.core.world import Pose2D, world_spec
 from mjswarm.experiments.embodied import EmbodiedConfig
 from mjswarm.experiments.exploration import EmbodiedExploration
 from mjswarm.experiments.faults import parse_fault
 from mjswarm.experiments.minds import make_minds
-from mjswarm.experiments.stations import VertexStations
 from mjswarm.worlds.navigation import calibration, conventions
 
 DT_S = 0.02
@@ -68,7 +68,7 @@ def test_a_body_that_moves_or_answers_on_the_radio_is_not_passed():
 
 
 def test_a_held_lane_is_granted_to_nobody_and_closes_no_cycle():
-    stations = VertexStations(load_arena("arena2"))
+    stations = VertexStations(vertex_fans(load_arena("arena2")))
     stations.lanes.request(9, "v4", "v3")  # robot 9 passes a body on the lane v4 -> v3
     stations.occupy(0, "v4")
     stations.occupy(1, "v3")

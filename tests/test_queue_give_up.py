@@ -125,9 +125,9 @@ def test_embodied_robots_that_give_up_their_place_still_map_the_arena(monkeypatc
     run = EmbodiedExploration(load_arena("lattice:3x3"), make_minds("incidence-dfs", 4, None),
                               EmbodiedConfig(physics="kinematic", speed_m_s=0.1))
     talk = []  # (robot, payload) both ways, in order
-    reply, receive = run.uplink.reply, run.stations._receive
+    reply, receive = run.uplink.reply, run.stations.entry.receive
     run.uplink.reply = lambda i, p: (talk.append((i, p)), reply(i, p))[1]
-    run.stations._receive = lambda i, p: (talk.append((i, p)), receive(i, p))[1]
+    run.stations.entry.receive = lambda i, p, t: (talk.append((i, p)), receive(i, p, t))[1]
     result = run.run()
     assert result.ended_because == "completed" and result.map_correct
     assert result.collisions == 0 and result.stopped_robots == []

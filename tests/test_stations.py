@@ -1,4 +1,5 @@
-"""Vertex entry (mjswarm.experiments.stations): holds, first-come grants, and no circular wait."""
+"""Vertex entry (algorithms.exploration.entry, run by mjswarm.experiments.stations): holds,
+first-come grants, and no circular wait."""
 
 from __future__ import annotations
 
@@ -9,16 +10,17 @@ import numpy as np
 import pytest
 
 from algorithms.exploration.entry import (EntryBusy, EntryGranted, EntryRequest, GiveUp,
-                                          LeftVertex, TurnedBack, VertexClear, Withdraw)
+                                          LeftVertex, TurnedBack, VertexClear, VertexStations,
+                                          Withdraw)
 from mjswarm.arena import incidence_angle, load_arena
+from mjswarm.arena.geometry import vertex_fans
 from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
-from mjswarm.experiments.stations import VertexStations
 from mjswarm.experiments.minds import make_minds
 
 
 @pytest.fixture
 def lattice():
-    return VertexStations(load_arena("lattice:3x3"))
+    return VertexStations(vertex_fans(load_arena("lattice:3x3")))
 
 
 def test_edge_towards_names_the_neighbour_along_an_angle(lattice):
@@ -100,7 +102,7 @@ def test_no_circular_wait_survives_a_grant(seed):
     rng = np.random.default_rng(seed)
     vertices = list(spec.vertices)
     team = rng.choice(len(vertices), size=rng.integers(2, 12), replace=False)
-    stations = VertexStations(spec)
+    stations = VertexStations(vertex_fans(spec))
     for robot, k in enumerate(team):
         stations.occupy(robot, vertices[k])
     for robot, k in enumerate(team):
@@ -124,17 +126,17 @@ def test_a_swap_grants_both_robots_and_tells_each_its_vertex_is_not_yet_clear():
                               EmbodiedConfig(), 0)
     u, w = load_arena("fig9").edges[0]
     run.launching.queue.clear()
-    run.stations.target[:] = [u, w]
-    run.stations.stations.occupy(0, u)
-    run.stations.stations.occupy(1, w)
-    run.stations.stations.request(0, u, w, 0.0)
-    run.stations.stations.request(1, w, u, 0.0)
+    run.stations.entry.target[:] = [u, w]
+    run.stations.entry.grants.occupy(0, u)
+    run.stations.entry.grants.occupy(1, w)
+    run.stations.entry.grants.request(0, u, w, 0.0)
+    run.stations.entry.grants.request(1, w, u, 0.0)
     run.stations.before_step(run.loop)
     run.uplink.step()
     replies = [[m.payload for m in run.uplink.receive_for(i)] for i in (0, 1)]
     assert replies == [[EntryGranted(clear=False)], [EntryGranted(clear=False)]]
-    assert run.stations.target == [w, u] and run.stations.leaving == [u, w]
-    run.stations._receive(0, LeftVertex())  # R1 is in its corridor: u is free for R2
+    assert run.stations.entry.target == [w, u] and run.stations.entry.leaving == [u, w]
+    _tell(run, 0, LeftVertex())  # R1 is in its corridor: u is free for R2
     run.uplink.step()
     assert [m.payload for m in run.uplink.receive_for(1)] == [VertexClear()]
     assert run.uplink.receive_for(0) == []
@@ -159,12 +161,18 @@ def _on_fig9(k: int = 2) -> tuple[EmbodiedExploration, str, str]:
 
 def _granted(run, i, u, w):
     """Robot ``i`` on ``u`` asks for the edge to ``w`` and gets it."""
-    run.stations.target[i] = u
-    run.stations.stations.occupy(i, u)
-    run.stations._receive(i, EntryRequest(_angle(run, u, w)))
+    run.stations.entry.target[i] = u
+    run.stations.entry.grants.occupy(i, u)
+    _tell(run, i, EntryRequest(_angle(run, u, w)))
     run.stations.before_step(run.loop)
     run.uplink.step()
     return [m.payload for m in run.uplink.receive_for(i)]
+
+
+def _tell(run, i, payload):
+    """Robot ``i``'s message reaches the stations, which answer at once."""
+    run.stations.entry.receive(i, payload, run.world.time_s)
+    run.stations._send(run.loop)
 
 
 def _angle(run, u, w):
@@ -174,10 +182,10 @@ def _angle(run, u, w):
 def test_a_robot_turning_back_short_of_its_corridor_gets_its_vertex_back_at_once():
     run, u, w = _on_fig9()
     assert _granted(run, 0, u, w) == [EntryGranted(True, _angle(run, u, w))]
-    run.stations._receive(0, TurnedBack(from_lane=False))
+    _tell(run, 0, TurnedBack(from_lane=False))
     run.uplink.step()
     assert [m.payload for m in run.uplink.receive_for(0)] == [EntryGranted(clear=True)]
-    assert run.stations.target[0] == u and run.stations.leaving[0] is None and run.stations.stations.holder == {u: 0}
+    assert run.stations.entry.target[0] == u and run.stations.entry.leaving[0] is None and run.stations.entry.grants.holder == {u: 0}
 
 
 def test_a_robot_turning_back_from_its_lane_waits_for_its_vertex_like_a_centre():
@@ -185,18 +193,18 @@ def test_a_robot_turning_back_from_its_lane_waits_for_its_vertex_like_a_centre()
     from its lane: granted when ``u`` is free, with the vertex ahead freed at once."""
     run, u, w = _on_fig9()
     _granted(run, 0, u, w)
-    run.stations._receive(0, LeftVertex())
-    run.stations.stations.occupy(1, u)
-    run.stations.target[1] = u
-    run.stations._receive(0, TurnedBack(from_lane=True))
-    assert run.stations.stations.holder == {u: 1} and run.stations.stations.requests[0].at is None
+    _tell(run, 0, LeftVertex())
+    run.stations.entry.grants.occupy(1, u)
+    run.stations.entry.target[1] = u
+    _tell(run, 0, TurnedBack(from_lane=True))
+    assert run.stations.entry.grants.holder == {u: 1} and run.stations.entry.grants.requests[0].at is None
     run.stations.before_step(run.loop)
-    assert run.stations.stations.holder == {u: 1}  # u is held: it waits
-    run.stations.stations.release(1, u)
+    assert run.stations.entry.grants.holder == {u: 1}  # u is held: it waits
+    run.stations.entry.grants.release(1, u)
     run.stations.before_step(run.loop)
     run.uplink.step()
     assert [m.payload for m in run.uplink.receive_for(0)] == [EntryGranted(True, None)]
-    assert run.stations.target[0] == u and run.stations.stations.holder == {u: 0}
+    assert run.stations.entry.target[0] == u and run.stations.entry.grants.holder == {u: 0}
 
 
 def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws():
@@ -204,21 +212,21 @@ def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws()
     into its old area gets no answer (it goes on), and one that withdraws leaves the
     other waiting until it has left its area."""
     run, u, w = _on_fig9()
-    run.stations.target[:] = [u, w]
-    run.stations.stations.occupy(0, u)
-    run.stations.stations.occupy(1, w)
+    run.stations.entry.target[:] = [u, w]
+    run.stations.entry.grants.occupy(0, u)
+    run.stations.entry.grants.occupy(1, w)
     for i, (a, b) in enumerate(((u, w), (w, u))):
-        run.stations._receive(i, EntryRequest(_angle(run, a, b)))
+        _tell(run, i, EntryRequest(_angle(run, a, b)))
     run.stations.before_step(run.loop)
     run.uplink.step()
     for i in (0, 1):
         run.uplink.receive_for(i)
-    run.stations._receive(0, TurnedBack(from_lane=False))
+    _tell(run, 0, TurnedBack(from_lane=False))
     run.uplink.step()
-    assert run.uplink.receive_for(0) == [] and run.stations.target == [w, u]
-    run.stations._receive(1, Withdraw())
-    assert run.stations.target[1] == w and run.stations.leaving[1] == w  # robot 0 still waits for it to go
-    assert run.stations.stations.holder == {w: 0}
+    assert run.uplink.receive_for(0) == [] and run.stations.entry.target == [w, u]
+    _tell(run, 1, Withdraw())
+    assert run.stations.entry.target[1] == w and run.stations.entry.leaving[1] == w  # robot 0 still waits for it to go
+    assert run.stations.entry.grants.holder == {w: 0}
     run.uplink.step()
     assert run.uplink.receive_for(0) == []  # no VertexClear for robot 0
 
@@ -226,30 +234,30 @@ def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws()
 def test_a_withdrawn_clear_grant_is_taken_back():
     run, u, w = _on_fig9()
     _granted(run, 0, u, w)
-    run.stations._receive(0, Withdraw())
-    assert run.stations.target[0] == u and run.stations.leaving[0] is None and run.stations.stations.holder == {u: 0}
+    _tell(run, 0, Withdraw())
+    assert run.stations.entry.target[0] == u and run.stations.entry.leaving[0] is None and run.stations.entry.grants.holder == {u: 0}
 
 
 def test_a_robot_that_gives_up_a_waiting_request_is_told_busy_and_never_granted():
     """Step 8: a request still waiting is dropped and answered ``EntryBusy`` with its
     angle; the vertex, freed later, is not granted to it; the robot keeps its own."""
     run, u, w = _on_fig9()
-    run.stations.target[:] = [u, w]
-    run.stations.stations.occupy(0, u)
-    run.stations.stations.occupy(1, w)  # w is held: robot 0's request waits
+    run.stations.entry.target[:] = [u, w]
+    run.stations.entry.grants.occupy(0, u)
+    run.stations.entry.grants.occupy(1, w)  # w is held: robot 0's request waits
     angle = _angle(run, u, w)
-    run.stations._receive(0, EntryRequest(angle))
+    _tell(run, 0, EntryRequest(angle))
     run.stations.before_step(run.loop)
     run.uplink.step()
     assert run.uplink.receive_for(0) == []
-    run.stations._receive(0, GiveUp())
+    _tell(run, 0, GiveUp())
     run.uplink.step()
     assert [m.payload for m in run.uplink.receive_for(0)] == [EntryBusy(angle)]
     assert run.stations.gave_up == 1
-    run.stations.stations.release(1, w)
+    run.stations.entry.grants.release(1, w)
     run.stations.before_step(run.loop)
     run.uplink.step()
-    assert run.uplink.receive_for(0) == [] and run.stations.stations.holder == {u: 0}
+    assert run.uplink.receive_for(0) == [] and run.stations.entry.grants.holder == {u: 0}
 
 
 def test_a_give_up_that_crosses_its_grant_leaves_the_grant_standing():
@@ -257,10 +265,10 @@ def test_a_give_up_that_crosses_its_grant_leaves_the_grant_standing():
     on its way stands and the robot obeys it (no grant is taken back half-way)."""
     run, u, w = _on_fig9()
     assert _granted(run, 0, u, w) == [EntryGranted(True, _angle(run, u, w))]
-    run.stations._receive(0, GiveUp())
+    _tell(run, 0, GiveUp())
     run.uplink.step()
     assert run.uplink.receive_for(0) == [] and run.stations.gave_up == 0
-    assert run.stations.target[0] == w and run.stations.stations.holder[w] == 0
+    assert run.stations.entry.target[0] == w and run.stations.entry.grants.holder[w] == 0
 
 
 @pytest.mark.parametrize("seed", range(6))

@@ -71,7 +71,7 @@ class Launching(LoopFunctions):
         present, done = self.world.present, self.roster.is_done
         if any(present[j] and not done(j) for j in np.flatnonzero(near).tolist()):
             return  # O(robots near the root), never O(K^2)
-        if self.stations.avoid and self.root in self.stations.stations.holder:
+        if self.stations.avoid and self.root in self.stations.entry.grants.holder:
             return
         i = self.queue.popleft()
         self.world.place(i, Pose2D(self.root_xy[0], self.root_xy[1], 0.0))
