@@ -308,3 +308,44 @@ def test_every_experiment_runs_on_sealed_controllers(sealed, monkeypatch):
     result = run_exploration(load_arena("lattice:3x3"), 4, world="graph", seed=0,
                              radio_range_m=1.3, connectivity="biconnected")
     assert result.messages > 0
+
+
+def test_the_world_never_calls_a_loop_function(monkeypatch):
+    """While the world senses, acts, steps or switches a robot off, no loop function's
+    code runs: loop functions hand the world the beacons and the faults in their hooks."""
+    from mjswarm.experiments.exploration import EmbodiedConfig
+    from mjswarm.experiments.faults import parse_fault
+    from mjswarm.experiments.runs import run_exploration
+    from mjswarm.worlds.loop import LoopFunctions
+    from mjswarm.worlds.sparkworld import SparkWorld
+
+    inside = []
+
+    def world_code(method):
+        def run(self, *args, **kwargs):
+            inside.append(method.__name__)
+            try:
+                return method(self, *args, **kwargs)
+            finally:
+                inside.pop()
+        return run
+
+    def experiment_code(cls, method):
+        def run(*args, **kwargs):
+            assert not inside, f"the world's {inside[-1]} called {cls.__name__}.{method.__name__}"
+            return method(*args, **kwargs)
+        return run
+
+    for name in ("observe", "act", "step", "power_off"):
+        monkeypatch.setattr(SparkWorld, name, world_code(getattr(SparkWorld, name)))
+    classes = [LoopFunctions]
+    while classes:
+        cls = classes.pop()
+        classes += cls.__subclasses__()
+        for name, method in list(vars(cls).items()):
+            if callable(method) and not name.startswith("__"):
+                monkeypatch.setattr(cls, name, experiment_code(cls, method))
+    result = run_exploration(load_arena("fig9"), 2, world="embodied", seed=0, max_time=12.0,
+                             config=EmbodiedConfig(speed_m_s=0.15,
+                                                   faults=(parse_fault("robot:2@6"),)))
+    assert any(f["fired"] for f in result.faults)

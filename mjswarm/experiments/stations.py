@@ -296,8 +296,6 @@ class StationService(LoopFunctions):
         #: requests dropped because their robot gave up its place in a queue
         self.gave_up = 0
         self.loop: Loop | None = None
-        world.beacon_at = self.beacon_at
-        world.power_listeners.append(self._switched_off)
 
     def initialize(self, loop: Loop) -> None:
         self.loop = loop
