@@ -95,7 +95,7 @@ def test_cr_and_dcr_lists_of_the_initiator_and_its_neighbours(seed):
     ids = team.ids
     nodes = {r: BiconnectivityCheck(r, n, initiator=r == ids[0]) for r in ids}
     radio = team.radio(range_m)
-    drive(radio, nodes, lambda: nodes[ids[0]].result is not None)
+    drive(radio, nodes, lambda _: nodes[ids[0]].result is not None)
     running = [r for r, node in nodes.items() if node.started_at is not None]
     assert ids[0] in running
     for r in running:
@@ -113,7 +113,7 @@ def figure1():
 def test_figure1_v_is_doubly_connected_to_all_but_not_biconnected():
     team = figure1()
     nodes = {r: BiconnectivityCheck(r, 5, initiator=r == "v") for r in team.ids}
-    drive(team.radio(), nodes, lambda: nodes["v"].result is not None)
+    drive(team.radio(), nodes, lambda _: nodes["v"].result is not None)
     v = nodes["v"]
     assert v.cr == v.dcr == {"a", "b", "c", "d"}  # |DCR_v| = |CR_v|: v says DC-TRUE
     assert v.result is False  # but its neighbours say DC-FALSE

@@ -27,13 +27,13 @@ def build(graph, reference, *, max_forwards=None, radio=None):
     """Run Algorithm 1 over ``graph``'s links until no message is in flight."""
     radio = radio or Radio(list(graph), edges=list(graph.edges))
     tables = {r: ConnectivityTable(r, reference, max_forwards=max_forwards) for r in graph}
-    tick, _ = drive(radio, tables, lambda: radio.last_batch == 0)
+    tick, _ = drive(radio, tables, lambda _: radio.last_batch == 0)
     return radio, tables, tick
 
 
 def settle(radio, tables, start):
     """Keep running after a topology change until quiet again."""
-    tick, _ = drive(radio, tables, lambda: radio.last_batch == 0, start=start)
+    tick, _ = drive(radio, tables, lambda _: radio.last_batch == 0, start=start)
     return tick
 
 
@@ -311,7 +311,7 @@ def moving_team_tables_match_recomputation(seed):
         for _ in range(int(rng.integers(1, 6))):
             positions = {r: p + rng.normal(0.0, 0.03, 2) for r, p in positions.items()}  # m
             radio.move(positions)
-            now = drive(radio, tables, lambda: True, start=now)[0] + 1
+            now = drive(radio, tables, lambda _: True, start=now)[0] + 1
         now = settle(radio, tables, now) + 1
         graph = radio.graph()
         _, fresh, _ = build(graph, ref)
@@ -362,7 +362,7 @@ def test_reports_reach_the_reference_by_2N_minus_1():
                 edges=(("a", "b"), ("b", "c"), ("c", "d"), ("d", "e"), ("e", "a")))
     radio = team.radio()
     nodes = {r: TableCheck(r, "a", 5, max_robots=7) for r in team.ids}
-    tick, _ = drive(radio, nodes, lambda: nodes["a"].connected is not None)
+    tick, _ = drive(radio, nodes, lambda _: nodes["a"].connected is not None)
     assert tick == 13 == nodes["a"].decision_tick
     assert (nodes["a"].connected, nodes["a"].biconnected) == (True, True)
     assert nodes["a"].articulation_points == frozenset()

@@ -9,6 +9,7 @@ protocol (a :class:`Sealed` controller fails on anything else)."""
 from __future__ import annotations
 
 import math
+import sys
 
 import mujoco
 import numpy as np
@@ -254,3 +255,97 @@ def test_the_connectivity_checks_hand_out_nothing_forbidden(watched, method):
     result = run_check(ring, method, range_m=0.9)
     assert result.connected and result.biconnected
     _clean(watched, 8)
+
+
+class SealedMind:
+    """A robot's mind that only the robot's own software (code of ``algorithms``) may
+    look into: an experiment reading it fails."""
+
+    def __init__(self, inner) -> None:
+        object.__setattr__(self, "_inner", inner)
+
+    def __getattribute__(self, name):
+        caller = sys._getframe(1).f_globals.get("__name__", "")
+        if not caller.startswith("algorithms."):
+            raise AssertionError(f"{caller} read the mind's {name!r}")
+        return getattr(object.__getattribute__(self, "_inner"), name)
+
+
+@pytest.fixture
+def sealed(monkeypatch):
+    """Every loop of the test runs sealed controllers (:class:`Sealed`)."""
+    init = Loop.__init__
+
+    def sealing_init(self, world, controllers, *args, **kwargs):
+        init(self, world, {i: Sealed(c) for i, c in controllers.items()}, *args, **kwargs)
+
+    monkeypatch.setattr(Loop, "__init__", sealing_init)
+
+
+def test_every_experiment_runs_on_sealed_controllers(sealed, monkeypatch):
+    """Coverage (adds and a dismissal), the connectivity checks, embodied, graph and
+    radio-graph exploration learn of their robots from telemetry and events only."""
+    from mjswarm.experiments.connectivity import harness
+    from mjswarm.experiments.connectivity.team import Team
+    from mjswarm.experiments.coverage import CoverageRun
+    from mjswarm.experiments.exploration import EmbodiedConfig
+    from mjswarm.experiments.runs import run_exploration
+
+    episodes = CoverageRun(2.0, "heuristic", "point", seed=0).run(3).episodes
+    assert {e.action for e in episodes} == {"add", "remove"}
+    checkers = harness._checkers
+    monkeypatch.setattr(harness, "_checkers", lambda *a: {
+        r: SealedMind(m) for r, m in checkers(*a).items()})
+    ring = Team(positions={f"r{i}": (math.cos(i * math.pi / 4), math.sin(i * math.pi / 4))
+                           for i in range(8)})
+    for method in ("stamps", "tables"):
+        check = harness.run_check(ring, method, range_m=0.9)
+        assert check.connected and check.biconnected
+    assert check.articulation_points == []
+    run_exploration(load_arena("fig9"), 2, world="embodied", seed=0, max_time=8.0,
+                    config=EmbodiedConfig(speed_m_s=0.15))
+    assert run_exploration(load_arena("fig9"), 3, world="graph", seed=0).completed
+    result = run_exploration(load_arena("lattice:3x3"), 4, world="graph", seed=0,
+                             radio_range_m=1.3, connectivity="biconnected")
+    assert result.messages > 0
+
+
+def test_the_world_never_calls_a_loop_function(monkeypatch):
+    """While the world senses, acts, steps or switches a robot off, no loop function's
+    code runs: loop functions hand the world the beacons and the faults in their hooks."""
+    from mjswarm.experiments.exploration import EmbodiedConfig
+    from mjswarm.experiments.faults import parse_fault
+    from mjswarm.experiments.runs import run_exploration
+    from mjswarm.worlds.loop import LoopFunctions
+    from mjswarm.worlds.sparkworld import SparkWorld
+
+    inside = []
+
+    def world_code(method):
+        def run(self, *args, **kwargs):
+            inside.append(method.__name__)
+            try:
+                return method(self, *args, **kwargs)
+            finally:
+                inside.pop()
+        return run
+
+    def experiment_code(cls, method):
+        def run(*args, **kwargs):
+            assert not inside, f"the world's {inside[-1]} called {cls.__name__}.{method.__name__}"
+            return method(*args, **kwargs)
+        return run
+
+    for name in ("observe", "act", "step", "power_off"):
+        monkeypatch.setattr(SparkWorld, name, world_code(getattr(SparkWorld, name)))
+    classes = [LoopFunctions]
+    while classes:
+        cls = classes.pop()
+        classes += cls.__subclasses__()
+        for name, method in list(vars(cls).items()):
+            if callable(method) and not name.startswith("__"):
+                monkeypatch.setattr(cls, name, experiment_code(cls, method))
+    result = run_exploration(load_arena("fig9"), 2, world="embodied", seed=0, max_time=12.0,
+                             config=EmbodiedConfig(speed_m_s=0.15,
+                                                   faults=(parse_fault("robot:2@6"),)))
+    assert any(f["fired"] for f in result.faults)

@@ -111,6 +111,11 @@ class Leave(NamedTuple):
     centre: Point
 
 
+class Dismiss(NamedTuple):
+    """The experimenter's order to leave the floor (from the station that runs the
+    episodes): the robot answers with its ``Leave`` broadcast and nothing else."""
+
+
 class Move(NamedTuple):
     key: tuple
     pos: Point
@@ -208,6 +213,13 @@ class BiconnectedRobot(Controller):
             raise ValueError(f"unknown placement {params.placement!r}")
         self.id = robot_id
         self.params = params
+        self._start = centre
+        self.reset()
+
+    def reset(self) -> None:
+        """Start afresh: in the team at the region given to the constructor, or joining
+        (a robot put back on the floor joins again)."""
+        robot_id, centre = self.id, self._start
         self.centre: Point | None = centre
         #: the region centres this robot knows, its own included once it holds one
         self.table: dict[Hashable, Point] = {} if centre is None else {robot_id: centre}
@@ -230,7 +242,7 @@ class BiconnectedRobot(Controller):
         self._held: tuple[tuple, dict[Hashable, Point]] = ((), {})
         self._path: tuple[tuple | None, list[Point]] = (None, [])  # (key, waypoints)
 
-    # -- what the runner asks -----------------------------------------------------------
+    # -- what it reports ---------------------------------------------------------------
     @property
     def busy(self) -> bool:
         """Joining, or leading a repair that has not ended."""
@@ -251,26 +263,27 @@ class BiconnectedRobot(Controller):
             self._held = (key, hold_points(self.table, self.params.clearance_m))
         return self._held[1]
 
-    def leave(self) -> Message:
-        """The message to broadcast just before this robot is taken off the floor."""
-        return Message(Leave(self.id, self.centre))
-
     # -- one control tick ---------------------------------------------------------------
     def step(self, observation: Observation) -> Command:
-        """One control tick from the robot's positioning sensor and radio."""
+        """One control tick from the robot's positioning sensor and radio; dismissed
+        (:class:`Dismiss` in the inbox), the robot only broadcasts its ``Leave``."""
+        if any(type(m.payload) is Dismiss for m in observation.inbox):
+            return Command(messages=(Message(Leave(self.id, self.centre)),))
         out, velocity = self.tick(round(observation.time_s / self.params.tick_s),
                                   observation.inbox, observation.neighbors, observation.pose)
         return Command(velocity_m_s=tuple(velocity), messages=tuple(out))
 
     def telemetry(self) -> dict[str, float]:
         """Busy (joining or leading a repair), regions it knows, MOVE floods and
-        distributed checks it led, and the region it guards: its centre (m) and radius
-        (m; absent while it has none)."""
+        distributed checks it led, the region it guards: its centre (m) and radius (m),
+        and where it holds (m; these absent while it has no region)."""
         out = {"busy": float(self.busy), "known_regions": len(self.table),
                "moves_led": self.moves_led, "checks_led": self.checks_led}
         if self.centre is not None:
+            hold = self.hold
             out |= {"region_x_m": float(self.centre[0]), "region_y_m": float(self.centre[1]),
-                    "region_radius_m": self.params.region_radius_m}
+                    "region_radius_m": self.params.region_radius_m,
+                    "hold_x_m": float(hold[0]), "hold_y_m": float(hold[1])}
         return out
 
     def tick(self, now: int, inbox: Iterable[Message], neighbors: Iterable[Hashable],

@@ -47,7 +47,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from algorithms.maintenance.biconnected import PLACEMENTS, BiconnectedRobot, Params
+from algorithms.maintenance.biconnected import PLACEMENTS, BiconnectedRobot, Dismiss, Params
 from algorithms.maintenance.regions import union_area
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.loop import Loop, LoopFunctions
@@ -172,20 +172,30 @@ class CoverageRun(LoopFunctions):
             self.world = EmbodiedFloor(starts, present=absent, seed=seed,
                                        floor_half_size_m=half, control_dt_s=tick)
         self.world.attach_radio(Radio(range(MAX_ROBOTS), range_m=self.params.link_m))
-        self.loop = Loop(self.world, {}, [self, *functions])
+        robots = {i: BiconnectedRobot(i, self.params) for i in range(MAX_ROBOTS)}
+        self.loop = Loop(self.world, robots, [self, *functions])
         self._ticks, self._running = 0, ""
         for _ in range(START_ROBOTS):
             self._episode("add", -1)
 
     @property
-    def minds(self) -> dict[int, BiconnectedRobot]:
-        """The team's controllers by robot id."""
-        return self.loop.controllers  # type: ignore[return-value]
+    def team(self) -> list[int]:
+        """The robots on the floor (the team), in id order."""
+        return self.world.active()
+
+    def _report(self, robot: int) -> dict:
+        """What robot ``robot`` reports of itself (its telemetry)."""
+        return self.loop.controllers[robot].telemetry()
+
+    def _hold(self, robot: int) -> tuple[float, float]:
+        """Where a robot of the team says it holds (m)."""
+        report = self._report(robot)
+        return report["hold_x_m"], report["hold_y_m"]
 
     # -- episodes -------------------------------------------------------------------------
     def step_episode(self) -> Episode:
         """One random add or remove, run until it has settled."""
-        n = len(self.minds)
+        n = len(self.team)
         add = n == 0 or (n < MAX_ROBOTS and self.rng.random() < 0.5)
         episode = self._episode("add" if add else "remove", len(self.coverage_result.episodes))
         self.coverage_result.episodes.append(episode)
@@ -202,7 +212,8 @@ class CoverageRun(LoopFunctions):
 
     def coverage(self) -> float | None:
         """S-coverage of the current regions (None for an empty team)."""
-        centres = [m.centre for m in self.minds.values()]
+        reports = [self._report(k) for k in self.team]
+        centres = [(t["region_x_m"], t["region_y_m"]) for t in reports]
         if not centres:
             return None
         r = self.params.region_radius_m
@@ -211,29 +222,32 @@ class CoverageRun(LoopFunctions):
     def _episode(self, action: str, index: int) -> Episode:
         world, radio = self.world, self.world.radio
         sent_before = radio.total_sent
+        team = self.team
+        led = {k: self._led(k) for k in team}  # the counts the episode adds to
         if action == "add":
-            robot = min(set(range(MAX_ROBOTS)) - set(self.minds))
+            robot = min(set(range(MAX_ROBOTS)) - set(team))
             world.place(robot, self._entry_point(), float(self.rng.uniform(-math.pi, math.pi)))
-            self.minds[robot] = BiconnectedRobot(robot, self.params)
         else:
-            robot = int(self.rng.choice(sorted(self.minds)))
-            if len(self.minds) == 1:  # nobody to tell, nothing to repair
+            robot = int(self.rng.choice(team))
+            if len(team) == 1:  # nobody to tell, nothing to repair
                 world.place(robot, None)
-                self.minds.pop(robot)
                 return Episode(index, action, robot, 0, None, 0, 0, 0, 0)
-            # its last broadcast, heard by its neighbours, then it is taken off the floor
-            radio.send(robot, self.minds[robot].leave().payload)
-            radio.step()
+            # dismissed: its last broadcast, heard by its neighbours, then off the floor
+            self.loop.last_words(robot, Dismiss())
             world.place(robot, None)
-            self.minds.pop(robot)
         self.loop.event(f"episode {index}: {action} R{robot + 1}", robot)
-        before = {k: (m.moves_led, m.checks_led) for k, m in self.minds.items()}
         self._ticks, self._running = 0, f"episode {index} ({action} robot {robot})"
         self.loop.run()
-        moves = sum(m.moves_led - before.get(k, (0, 0))[0] for k, m in self.minds.items())
-        checks = sum(m.checks_led - before.get(k, (0, 0))[1] for k, m in self.minds.items())
-        return Episode(index, action, robot, len(self.minds), self.coverage(), self._ticks,
-                       radio.total_sent - sent_before, moves, checks)
+        gained = [(m - led.get(k, (0, 0))[0], c - led.get(k, (0, 0))[1])
+                  for k in self.team for m, c in [self._led(k)]]
+        return Episode(index, action, robot, len(self.team), self.coverage(), self._ticks,
+                       radio.total_sent - sent_before, sum(m for m, _ in gained),
+                       sum(c for _, c in gained))
+
+    def _led(self, robot: int) -> tuple[int, int]:
+        """The MOVE floods and distributed checks ``robot`` says it has led."""
+        report = self._report(robot)
+        return report["moves_led"], report["checks_led"]
 
     # -- loop-function hooks ----------------------------------------------------------------
     def after_step(self, loop: Loop) -> None:
@@ -251,16 +265,19 @@ class CoverageRun(LoopFunctions):
         return self.coverage_result
 
     def _settled(self) -> bool:
-        if self.world.radio.last_batch or any(m.busy for m in self.minds.values()):
+        if self.world.radio.last_batch:
+            return False
+        reports = {k: self._report(k) for k in self.team}
+        if any(t["busy"] for t in reports.values()):
             return False
         truth = self.world.true_positions()
-        return all(math.dist(truth[k], m.hold) <= self.params.tolerance_m
-                   for k, m in self.minds.items())
+        return all(math.dist(truth[k], (t["hold_x_m"], t["hold_y_m"])) <= self.params.tolerance_m
+                   for k, t in reports.items())
 
     def _entry_point(self) -> tuple[float, float]:
-        if not self.minds:
+        if not self.team:
             return 0.0, 0.0
-        host = self.minds[int(self.rng.choice(sorted(self.minds)))].hold
+        host = self._hold(int(self.rng.choice(self.team)))
         a = self.rng.uniform(-math.pi, math.pi)
         truth = self.world.true_positions()
         robots = [truth[k] for k in range(MAX_ROBOTS) if self.world.present[k]]

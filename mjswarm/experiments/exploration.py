@@ -8,13 +8,14 @@ robots and composes the experiment of small loop functions (ARGoS's term), each 
 module of its own: ground truth of connectivity (:mod:`mjswarm.experiments.awareness`),
 faults (:mod:`mjswarm.experiments.faults`), launching (:mod:`mjswarm.experiments.
 launching`), the vertex stations with the beacon service (:mod:`mjswarm.experiments.
-stations`) and the metrics (:mod:`mjswarm.experiments.metrics`); the base station and a
-docked robot are controllers of fixed radio nodes, stepped by the loop. None of them
-reads a controller's attributes: the robots report through typed events and telemetry.
-A recording is a loop function the caller hands in. One tick::
+stations`, :mod:`mjswarm.experiments.beacon_hand`) and the metrics
+(:mod:`mjswarm.experiments.metrics`); the base station and a docked robot are
+controllers of fixed radio nodes, stepped by the loop. None of them reads a
+controller's attributes: the robots report through typed events and telemetry. A
+recording is a loop function the caller hands in. One tick::
 
     before: truth sample (tables) -> faults -> launch -> stations' mail and grants
-            -> the observed state (metrics)
+            -> the beacons handed to the world -> the observed state (metrics)
     loop:   sense base, docked robot and robots -> control -> act -> world step
     after:  metrics from reports and telemetry -> beliefs against truth -> tether truth
             -> recording; stop when completed, infeasible, all stopped or stalled
@@ -118,6 +119,7 @@ from mjswarm.experiments.embodied import (  # noqa: F401 - the experiment's publ
     stall_timeout,
     tether_unit_ticks,
 )
+from mjswarm.experiments.beacon_hand import BeaconHand
 from mjswarm.experiments.faults import Faults
 from mjswarm.experiments.launching import Launching, depot
 from mjswarm.experiments.metrics import (
@@ -237,7 +239,6 @@ class EmbodiedExploration(LoopFunctions):
         nearest = NearestVertex(self.sim, spec, world.present)
         self.beliefs = (BeliefSampling(world) if world.radio is not None and not tied
                         else None)
-        self.faults = Faults(world, config.faults)
         self.stations = StationService(spec, world, self.uplink, nearest,
                                        config.collision_avoidance)
         self.launching = Launching(spec, world, order, config.launch_interval_s,
@@ -245,9 +246,12 @@ class EmbodiedExploration(LoopFunctions):
         self.metrics = ExplorationMetrics(
             world, self.roster, nearest, spec.root, None if tied else stall_timeout(spec, config),
             lambda paths: infeasible_reason(k, config.radio_range_m, paths, len(spec.edges)))
+        self.faults = Faults(world, config.faults, switched_off=(
+            self.stations.switched_off, self.launching.switched_off, self.metrics.switched_off))
         self.tether_truth = TetherTruth(world) if tied else None
         return [f for f in (self.beliefs, self.faults, self.launching, self.stations,
-                            self.metrics, self.tether_truth, self) if f is not None]
+                            BeaconHand(world, self.stations), self.metrics,
+                            self.tether_truth, self) if f is not None]
 
     # ------------------------------------------------------------------ running
     def run(self, progress: bool = False) -> EmbodiedResult:

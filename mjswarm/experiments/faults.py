@@ -31,6 +31,7 @@ Sensor noise and wheel slip are options of their own (``--line-noise``, ``--ir-n
 from __future__ import annotations
 
 import re
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from mjswarm.arena import ArenaSpec
@@ -53,8 +54,13 @@ class RobotFailure:
             raise MjswarmError(f"fault {self}: there are robots 1..{n_robots}")
 
     def apply(self, world) -> list:
-        world.power_off(self.robot, f"failed (fault {self})")
+        world.power_off(self.robot)
         return []
+
+    @property
+    def reason(self) -> str:
+        """Why the robot stopped, as the run's metrics say it."""
+        return f"failed (fault {self})"
 
     def __str__(self) -> str:
         return f"robot:{self.robot + 1}@{self.at_s:g}"
@@ -159,12 +165,16 @@ def parse_fault(text: str) -> Fault:
 class Faults(LoopFunctions):
     """Injects ``faults`` into ``world`` at the control tick nearest to each one's time;
     a fault acts through the world only (a robot switched off, a beacon wiped, the radio
-    blacked out), never inside a controller. :meth:`log` says which fired, and when."""
+    blacked out), never inside a controller. :meth:`log` says which fired, and when.
+    ``switched_off``: the other loop functions' handlers of a robot switched off,
+    ``handler(robot, reason)``, called in order as the fault fires."""
 
-    def __init__(self, world, faults) -> None:
+    def __init__(self, world, faults,
+                 switched_off: Sequence[Callable[[int, str], None]] = ()) -> None:
         self.world = world
         self.pending = sorted(faults, key=lambda f: f.at_s)
         self.fired: list[dict] = []
+        self.switched_off = tuple(switched_off)
 
     def before_step(self, loop: Loop) -> None:
         world = self.world
@@ -172,6 +182,9 @@ class Faults(LoopFunctions):
         while self.pending and self.pending[0].at_s <= now:
             fault = self.pending.pop(0)
             self.pending = sorted([*self.pending, *fault.apply(world)], key=lambda f: f.at_s)
+            if isinstance(fault, RobotFailure):
+                for handler in self.switched_off:
+                    handler(fault.robot, fault.reason)
             self.fired.append({"fault": str(fault), "fired": True,
                                "at_s": round(world.time_s, 2)})
             loop.event(f"fault: {fault}")

@@ -48,9 +48,9 @@ class Launching(LoopFunctions):
         self.queue = deque(order)
         self.interval_s = interval_s
         self.last_launch_s = -math.inf
-        world.power_listeners.append(self._switched_off)
 
-    def _switched_off(self, i: int, reason: str) -> None:
+    def switched_off(self, i: int, reason: str) -> None:
+        """Robot ``i`` was switched off (a fault): unlaunched, it never will be."""
         if i in self.queue:  # not launched yet: it never will be
             self.queue.remove(i)
 

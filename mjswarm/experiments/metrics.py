@@ -86,9 +86,8 @@ class ExplorationMetrics(LoopFunctions):
         self.ended_because = "max time"
         self._observed = (0.0, None)  # (time s, true poses) at the start of the tick
         self._loop: Loop | None = None
-        world.power_listeners.append(self._switched_off)
 
-    def _switched_off(self, i: int, reason: str) -> None:
+    def switched_off(self, i: int, reason: str) -> None:
         """A robot switched off (a fault) stops, unless it had stopped or declared."""
         if i not in self.roster.finished:
             self._stop(i, reason, self.world.time_s)

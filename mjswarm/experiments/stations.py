@@ -132,8 +132,6 @@ class StationService(LoopFunctions):
         self.entry = EntryStations(vertex_fans(spec), world.n, avoid,
                                    BodySight(spec, world, nearest))
         self.loop: Loop | None = None
-        world.beacon_at = self.beacon_at
-        world.power_listeners.append(self._switched_off)
 
     @property
     def closed(self) -> dict[str, tuple[int, float]]:
@@ -148,7 +146,9 @@ class StationService(LoopFunctions):
     def initialize(self, loop: Loop) -> None:
         self.loop = loop
 
-    def _switched_off(self, i: int, reason: str) -> None:
+    def switched_off(self, i: int, reason: str) -> None:
+        """Robot ``i`` was switched off (a fault): its holds go, and a vertex whose area
+        its body is in closes."""
         if self.world.present[i]:  # one still in the depot holds nothing
             self.entry.release(i, self.world.time_s)
             self._send()

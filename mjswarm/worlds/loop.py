@@ -54,6 +54,10 @@ from algorithms.robot import NOTHING, Command, Controller, Message, Observation
 from mjswarm.errors import MjswarmError
 from mjswarm.core.radio import Radio
 
+#: The sender of the orders an experimenter hands a robot (:meth:`Loop.last_words`).
+STATION = "station"
+
+
 class World(ABC):
     """The surface a :class:`Loop` drives: ``observe``, ``act``, ``step``, and ground truth
     for loop functions, metrics and recordings only.
@@ -77,6 +81,9 @@ class World(ABC):
     #: robots off the floor whose radio is on the air at a fixed point, by id: position
     #: (m) (a robot docked at a base station, rule 1 of :mod:`algorithms.exploration.tether`)
     docked: Mapping = NOTHING
+    #: how many times a robot left the floor (the loop resets a robot that comes back,
+    #: even when it comes back before the next tick)
+    departures: int = 0
     #: radio nodes off the floor that the loop steps every tick before the robots (a base
     #: station, a docked robot): their controllers observe and act as robots do, and are
     #: never reset by the loop (they never enter the floor)
@@ -286,6 +293,7 @@ class Loop:
         self._perceive = any(type(c).perceive is not Controller.perceive
                              for c in self.controllers.values())
         self._on_floor: set = set()  # robots reset since they last entered the floor
+        self._departures = world.departures  # the world's count when _on_floor was taken
         self._stop = False
         for f in functions:
             self.add(f)
@@ -304,6 +312,17 @@ class Loop:
         every loop function hears it (:meth:`LoopFunctions.on_event`)."""
         for f in self.functions:
             f.on_event(self, text, robot)
+
+    def last_words(self, i: int, order: Any) -> None:
+        """Robot ``i``'s last tick, between two ticks of the run: it steps alone on an
+        observation whose inbox holds only ``order`` (an experimenter's message, such as
+        a dismissal from a station), its messages go on the air and the radio delivers
+        them at once. The caller takes the robot off the floor next."""
+        world = self.world
+        command = self.controllers[i].step(
+            Observation(i, world.time_s, inbox=(Message(order, i, STATION),)))
+        world._send(i, command.messages)
+        world.radio.step()
 
     def scenes(self) -> list[Scene]:
         """What the loop functions show on a picture of the run now."""
@@ -354,7 +373,9 @@ class Loop:
         """Reset the controllers of robots that entered the floor since the last tick
         (before their first step, and after each time they were off the floor)."""
         on_floor, world = self._on_floor, self.world
-        if len(on_floor) != world.robots_on_floor():  # someone left the floor
+        if (len(on_floor) != world.robots_on_floor()
+                or self._departures != world.departures):  # someone left the floor
+            self._departures = world.departures
             self._on_floor = on_floor = {i for i in on_floor if world.on_floor(i)}
         if on_floor.issuperset(robots):
             return

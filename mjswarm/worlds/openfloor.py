@@ -114,6 +114,7 @@ class MotionWorld(World, ABC):
     def place(self, i: int, xy: tuple[float, float] | None, yaw: float = 0.0) -> None:
         """Put robot ``i`` on the floor at ``xy`` (m) heading ``yaw`` (rad), or take it off
         (``None``): the experimenter's hand. It is on the air exactly while on the floor."""
+        self.departures += bool(self.present[i]) and xy is None
         self.present[i] = xy is not None
         self._put(i, xy, yaw)
         self._sensed = self._detections = None

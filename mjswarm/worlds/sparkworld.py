@@ -4,7 +4,7 @@
 bench's rows, any world from :func:`mjswarm.core.world.world_spec`). Each tick a robot
 observes its own rangefinders, encoders, wheel speeds and battery (the simulation's
 sensor record), the bearings its :class:`~mjswarm.core.bearing.BearingSensor` reports, its
-radio, and the beacon under it when the loop functions keep beacons (``beacon_at``);
+radio, and the beacon the loop functions handed it for the tick (:meth:`SparkWorld.hand_beacons`);
 its ``(v, omega)`` command goes to the wheels through the model's motors. The radio's
 links need line of sight both ways (:func:`mjswarm.core.radio.sight_blocker`).
 
@@ -12,12 +12,13 @@ Every robot is on the floor unless a loop function says otherwise (``present``: 
 waiting in a depot off the arena are neither stepped nor on the air).
 
 **Beacons** (``beacons``, a store keyed by vertex) belong to the world: loop functions
-decide which vertex's beacon a robot may read now (``beacon_at``), and the robot gets a
+decide in their ``before_step`` which vertex's beacon each robot may read in the tick and
+hand it to the world (:meth:`SparkWorld.hand_beacons`), and the robot gets a
 :class:`~algorithms.exploration.base.BeaconHandle` that works until the world steps.
 A fault wipes one with :meth:`SparkWorld.wipe_beacon`. **Power**: a robot switched off
-(:meth:`SparkWorld.power_off`, a fault) stands where it is, off the air, and is no
-longer stepped; loop functions that must know (the stations see its body) listen
-through ``power_listeners``. **Fixed radio nodes** (a base station at ``fixed``, robots
+(:meth:`SparkWorld.power_off`, a fault handed in by a loop function) stands where it is,
+off the air, and is no longer stepped. The world never calls a loop function.
+**Fixed radio nodes** (a base station at ``fixed``, robots
 ``docked`` at it) are stepped by the loop before the robots (``nodes``): they observe
 their radio only and answer with messages.
 """
@@ -25,7 +26,7 @@ their radio only and answer with messages.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -44,9 +45,6 @@ class SparkWorld(World):
         sim: the MuJoCo world.
         bearing: the robots' bearing sensor (None: robots have none).
         present: which robots are on the floor (default all).
-        beacon_at: ``beacon_at(i)``, the vertex (a key of ``beacons``) whose beacon robot
-            ``i`` can read now (the station of the vertex whose centre it stands on), else
-            None; set by loop functions.
         beacons: the beacon store, by vertex (None: no beacons).
         ranging: robots carry a radio-ranging sensor (as ultra-wideband radios do): the
             range and bearing of every radio neighbour, fixed nodes included, noise-free,
@@ -55,18 +53,18 @@ class SparkWorld(World):
 
     def __init__(self, sim: Simulation, bearing: BearingSensor | None = None,
                  present: np.ndarray | None = None,
-                 beacon_at: Callable[[int], Any] | None = None, ranging: bool = False,
+                 ranging: bool = False,
                  beacons: dict | None = None) -> None:
         self.sim = sim
         self.n = sim.n
         self.present = np.ones(self.n, bool) if present is None else np.array(present, bool)
         self.control_dt_s = sim.control_dt_s
         self.bearing = bearing
-        self.beacon_at = beacon_at
         self.beacons = beacons
+        #: the vertex whose beacon each robot may read in this tick, by robot
+        #: (:meth:`hand_beacons`); a robot not in it reads none
+        self._beacon_of: Mapping[int, Any] = NOTHING
         self.powered = np.ones(self.n, bool)
-        #: called with ``(robot, reason)`` when a robot is switched off
-        self.power_listeners: list[Callable[[int, str], None]] = []
         self._handles: list[BeaconHandle] = []  # handed out this tick
         self.uplinks = {}
         self.fixed = {}
@@ -150,7 +148,7 @@ class SparkWorld(World):
         """Every robot of ``robots``' readings at once, with no Python step per robot: the
         simulation's sensor record, the bearing sensor's pairs, the radio's inboxes (a
         team has no ranging, beacons or station links: those robots step one by one)."""
-        if self.ranging or self.beacon_at is not None or self.uplinks:
+        if self.ranging or self.beacons is not None or self.uplinks:
             raise MjswarmError("a batched team has no ranging, beacons or station links")
         k = np.asarray(robots, np.intp)
         r = self._sense()[k]
@@ -176,9 +174,16 @@ class SparkWorld(World):
                 raise MjswarmError("a team broadcast but the world has no radio")
             self.radio.send_all(k[commands.broadcast].tolist(), commands.payload)
 
+    def hand_beacons(self, vertices: Mapping[int, Any]) -> None:
+        """Which vertex's beacon (a key of ``beacons``) each robot may read in this tick,
+        by robot; robots not in ``vertices`` read none. Loop functions hand it in their
+        ``before_step`` (the stations: the vertex whose centre a robot stands on, when
+        they let it read there); it holds until the world steps."""
+        self._beacon_of = vertices
+
     def _beacon(self, i: int) -> BeaconHandle | None:
         """A handle on the beacon robot ``i`` may read now, good until the world steps."""
-        vertex = None if self.beacon_at is None else self.beacon_at(i)
+        vertex = self._beacon_of.get(i)
         if vertex is None:
             return None
         handle = BeaconHandle(self.beacons[vertex])
@@ -189,14 +194,12 @@ class SparkWorld(World):
         """The beacon at ``vertex`` loses its contents and id (a fault)."""
         self.beacons[vertex] = type(self.beacons[vertex])()
 
-    def power_off(self, i: int, reason: str) -> None:
+    def power_off(self, i: int) -> None:
         """Switch robot ``i`` off (a fault): it stands where it is (its body stays), off
-        the air, and is never stepped again; ``power_listeners`` hear of it."""
+        the air, and is never stepped again."""
         self.powered[i] = False
         self._v[i] = self._w[i] = 0.0
         self.set_on_air(i, False)
-        for listener in self.power_listeners:
-            listener(i, reason)
 
     def _ranges(self, i: int, neighbors) -> dict:
         """Robot ``i``'s ranging of its radio neighbours: range (m) and bearing (rad)."""
@@ -235,6 +238,7 @@ class SparkWorld(World):
             for handle in self._handles:
                 handle.expire()
             self._handles = []
+        self._beacon_of = NOTHING
         self.sim.set_velocity(np.array(self._v), np.array(self._w))
         self.sim.step()
         self._radio_step()

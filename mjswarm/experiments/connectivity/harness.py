@@ -20,7 +20,7 @@ from collections.abc import Callable, Hashable, Mapping
 from dataclasses import asdict, dataclass
 
 from algorithms.connectivity import BiconnectivityCheck, TableCheck
-from algorithms.connectivity.participant import MessagePassing, Participant
+from algorithms.connectivity.participant import MessagePassing, Participant, Verdict
 from mjswarm.experiments.connectivity.team import Team
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.loop import Loop, LoopFunctions
@@ -60,30 +60,46 @@ class CheckResult:
 
 
 class _Until(LoopFunctions):
-    """Stops the harness when ``until()`` holds after a tick, or once more than ``cap``
-    messages were sent (checked after each tick: a tick adds at most one round of
+    """Stops the harness when ``until(loop)`` holds after a tick, or once more than
+    ``cap`` messages were sent (checked after each tick: a tick adds at most one round of
     every robot's messages)."""
 
-    def __init__(self, until: Callable[[], bool], cap: int | None) -> None:
+    def __init__(self, until: Callable[[Loop], bool], cap: int | None) -> None:
         self.until, self.cap, self.capped = until, cap, False
 
     def should_stop(self, loop: Loop) -> bool:
         if self.cap is not None and loop.world.radio.total_sent > self.cap:
             self.capped = True
             return True
-        return self.until()
+        return self.until(loop)
+
+
+class _Decision:
+    """Watches the robots' reports for ``decider``'s :class:`Verdict` (the harness's
+    stopping rule)."""
+
+    def __init__(self, decider: Hashable) -> None:
+        self.decider, self.verdict = decider, None
+
+    def __call__(self, loop: Loop) -> bool:
+        for robot, event in loop.reports:
+            if robot == self.decider and type(event) is Verdict:
+                self.verdict = event
+        return self.verdict is not None
 
 
 def drive(
     radio: Radio,
     robots: Mapping[Hashable, MessagePassing],
-    until: Callable[[], bool],
+    until: Callable[[Loop], bool],
     *,
     start: int = 0,
     max_ticks: int = 10_000,
     message_cap: int | None = None,
 ) -> tuple[int, bool]:
-    """Run ticks ``start, start + 1, ...`` until ``until()`` holds after a tick.
+    """Run ticks ``start, start + 1, ...`` until ``until(loop)`` holds after a tick (it
+    reads the loop's reports, such as a :class:`~algorithms.connectivity.participant.
+    Verdict`).
 
     ``robots`` maps radio ids to message-passing minds (``tick(now, inbox, neighbors)``),
     each run as a :class:`~algorithms.connectivity.participant.Participant` by one
@@ -150,21 +166,17 @@ def run_check(
         raise MjswarmError(f"message cap must be at least 1, got {message_cap}")
     radio = team.radio(range_m, drop_prob=drop_prob, rng=seed)
     nodes = _checkers(method, ids, leader, max_robots)
-    decider = nodes[leader]
-    rounds, capped = drive(
-        radio,
-        nodes,
-        lambda: decider.connected is not None,
-        message_cap=message_cap,
-    )
-    points = getattr(decider, "articulation_points", None)
+    decision = _Decision(leader)
+    rounds, capped = drive(radio, nodes, decision, message_cap=message_cap)
+    verdict = None if capped else decision.verdict
+    points = None if verdict is None else verdict.articulation_points
     return CheckResult(
         method=method,
         robots=n,
         initiator=leader,
-        connected=None if capped else decider.connected,
-        biconnected=None if capped else decider.biconnected,
-        articulation_points=None if capped or points is None else sorted(points),
+        connected=None if verdict is None else verdict.connected,
+        biconnected=None if verdict is None else verdict.biconnected,
+        articulation_points=None if points is None else list(points),
         messages=radio.total_sent,
         max_messages_per_robot=max(radio.sent.values()),
         deliveries=sum(radio.received.values()),
