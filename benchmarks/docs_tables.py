@@ -8,6 +8,7 @@ the old one. Run from the repository root:
     python benchmarks/docs_tables.py papers          # the papers' results, reproduced
     python benchmarks/docs_tables.py performance     # speed against bare mj_step
     python benchmarks/docs_tables.py papers --only fig9,coverage
+    python benchmarks/docs_tables.py connected       # exploration that stays connected
 
 Wall-clock figures depend on what else the machine is doing: run it on a quiet machine.
 """
@@ -23,8 +24,9 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-if __package__ in (None, ""):  # run as a script: make the repository importable
+if __package__ in (None, ""):  # run as a script: the repository and its benchmarks importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 ROOT = Path(__file__).resolve().parents[1]
 TABLES = ROOT / "docs" / "tables"
@@ -226,11 +228,43 @@ def cli_help() -> str:
             + "\n\nCommand: `python benchmarks/cli_help_time.py`.")
 
 
+# --- exploration that stays connected ----------------------------------------------
+
+def connected_arena2() -> str:
+    from mjswarm.arena import load_arena
+    from mjswarm.experiments.runs import run_exploration
+
+    rows = []
+    for walls in (True, False):
+        for range_m, constraint in ((1.5, "connected"), (2.5, "connected"),
+                                    (1.5, "biconnected"), (2.5, "biconnected")):
+            r = run_exploration(load_arena("arena2"), 4, radio_range_m=range_m,
+                                connectivity=constraint, radio_walls=walls)
+            outcome = "completed" if r.completed else (r.reason or "not completed").split(
+                ":")[0].split(" with ")[0] + ", " + (r.reason or "").split("explored ")[-1]
+            rows.append(["walls" if walls else "open", f"{range_m:g}", constraint, outcome,
+                         f"{r.makespan:.1f}" if r.completed else "-", r.messages,
+                         r.relay_trips, f"{100 * r.connected_share:.1f} %",
+                         f"{100 * r.biconnected_share:.1f} %"])
+    return (table(["radio", "R (m)", "constraint", "outcome", "makespan", "messages",
+                   "relay trips", "every robot reached the base", "biconnected"], rows)
+            + "\n\nCommand: `mjswarm explore --world graph --arena arena2 --robots 4 "
+              "--radio-range R --connectivity C --radio-model M`.")
+
+
+def connected_worlds() -> str:
+    from connected_worlds import CASES, markdown, rows
+
+    return markdown(rows(CASES, jobs=2)) + (
+        "\n\nCommand: `python benchmarks/connected_worlds.py`.")
+
+
 GROUPS: dict[str, dict[str, Callable[[], str]]] = {
     "papers": {"fig9": fig9, "comparisons": comparisons, "trees": trees,
                "embodied": embodied, "coverage": coverage, "forwarding": forwarding},
     "performance": {"bench": bench, "main_job": main_job, "graph_world": graph_world,
                     "record_cost": record_cost, "cli_help": cli_help},
+    "connected": {"connected_arena2": connected_arena2, "connected_worlds": connected_worlds},
 }
 
 

@@ -43,7 +43,7 @@ def entities(path: Path) -> dict[str, list]:
 @pytest.fixture(scope="module")
 def graph_recordings(tmp_path_factory) -> dict[str, Path]:
     tmp = tmp_path_factory.mktemp("graph")
-    runs = {"graph": [], "connected": ["--robots", "3", "--radio-range", "1.5",
+    runs = {"graph": [], "connected": ["--robots", "3", "--radio-range", "2",
                                        "--connectivity", "connected"]}
     out = {}
     for name, extra in runs.items():

@@ -62,7 +62,7 @@ def recording(tmp_path_factory) -> Path:
 GRAPH_RUNS = {
     "graph world": ["explore", "--world", "graph", "--arena", "fig9", "--robots", "2"],
     "radio graph world": ["explore", "--world", "graph", "--arena", "fig9", "--robots", "3",
-                          "--radio-range", "1.5", "--connectivity", "connected"],
+                          "--radio-range", "2", "--connectivity", "connected"],
 }
 
 

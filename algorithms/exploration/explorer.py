@@ -187,7 +187,7 @@ class Explorer(Controller):
         #: its connected exploration (rules 1-6) around ``strategy``; None without a tether
         self.connected = None if tether is None else ConnectedExplorer(
             tether.me, strategy, tether, spacing=RELAY_SPACING_M)
-        #: its leash on bodies (None without a tether)
+        #: its leash against walls (None without a tether)
         self.leash = None if tether is None else Leash(tether)
         #: passing bodies on its lane (None where it does not pass: tethered, or no radius)
         self.body_watch = (BodyWatch(calibration.body_radius_m)
@@ -304,9 +304,11 @@ class Explorer(Controller):
     def _on_leash(self, now: int, command: Command, around) -> Command:
         """Rules 3-6 on this tick's command: it stands where the leash (or a wall it met
         on this leg) forbids its drive, then asks and beats."""
-        wanted = self.leash.check(command, self.control_dt_s, around,
-                                  back=self.mode in RETURNING, at_centre=self.nav.state in (
-                                      NavigatorState.SCANNING, NavigatorState.AT_VERTEX))
+        moving = command.v_m_s != 0.0
+        wanted = self.leash.check(
+            (command.v_m_s, command.omega_rad_s) if moving else None,
+            (command.v_m_s * self.control_dt_s, 0.0), around, back=self.mode in RETURNING,
+            at_centre=self.nav.state in (NavigatorState.SCANNING, NavigatorState.AT_VERTEX))
         if wanted is not None:
             command = Command(messages=command.messages)
         out = list(command.messages)
@@ -336,7 +338,7 @@ class Explorer(Controller):
         walls): drive its last moves backwards until the link is back, then wait for a new
         parent as if the leash had stopped it (on a vertex centre, at once: a robot backed
         out of the centre it scans on would scan off it, find no beacon and stop)."""
-        move = self.leash.undo(around, self.mode in RETURNING)
+        move = self.leash.undo(around, self.mode in RETURNING, lambda vw: (-vw[0], -vw[1]))
         if move is None:
             return self._stand(now, out, around)
         out.append(self.tether.beat(now, True, False, len(self.strategy.map_edges())))

@@ -19,6 +19,7 @@ from collections.abc import Mapping
 
 from algorithms.exploration.base import Strategy, angle_gap
 from algorithms.exploration.events import Declared, Infeasible, VertexCalled
+from algorithms.exploration.leash import Leash
 from algorithms.exploration.relay import MODES, ConnectedExplorer
 from algorithms.exploration.tether import BASE
 from algorithms.robot import STOP, Command, Controller, Observation
@@ -96,8 +97,11 @@ class TetheredExplorer(Controller):
     Move phase: :meth:`perceive` reads the radio (``hear``) and, at a vertex call, does
     the arrival's bookkeeping (``arrive``: every robot of the tick before any decides);
     :meth:`step` decides at a vertex call (``on_vertex``), then on an edge (or leaving
-    one) asks ``direction`` and, for the step, the tether's ``may_step`` (rule 3), and
-    answers with what it heard to send on. Answer phase: a walk back that reached the
+    one) asks ``direction`` and, for the step, its leash (the tether's ``may_step``, rule
+    3, and the ways a wall closed: :class:`~algorithms.exploration.leash.Leash`), and
+    answers with what it heard to send on; with ``walls`` (its arena's walls may cut a
+    link the leash allowed) a robot on an edge whose parent's link is gone steps its last
+    steps back instead, never back onto the vertex it left. Answer phase: a walk back that reached the
     vertex is told (``arrived_back``), then ``after`` (adoption requests, beats) and rule
     5's verdict, reported as :class:`~algorithms.exploration.events.Infeasible`. With
     ``constrained`` False (no constraint to keep) it only walks its strategy: it never
@@ -105,14 +109,17 @@ class TetheredExplorer(Controller):
     """
 
     def __init__(self, connected: ConnectedExplorer, constrained: bool = True,
-                 report: bool = False) -> None:
+                 report: bool = False, walls: bool = False) -> None:
         self.connected = connected
         self.constrained = constrained
         self.report = report
+        self.walls = walls
         self._ticks_per_unit = connected.tether.ticks_per_unit
         self._out: list = []  # what it heard to send on
         self._wanted = None  # the step the tether forbade it in this tick's move phase
         self._moved = self._back = False
+        #: its leash against walls (:mod:`~algorithms.exploration.leash`)
+        self.leash = Leash(connected.tether) if constrained else None
 
     def telemetry(self) -> Mapping[str, float]:
         """``relay_trips``: relay missions it set out on (rule 6); ``mode``: the index of
@@ -144,6 +151,7 @@ class TetheredExplorer(Controller):
     def _move(self, observation: Observation) -> Command:
         c, leg, vertex = self.connected, observation.leg, observation.vertex
         out, self._out = tuple(self._out), []
+        was_back = self._back
         self._wanted, self._moved, self._back = None, False, False
         steps, progress, edge_rad = leg.steps_m, leg.progress, None
         if vertex is not None:
@@ -159,11 +167,20 @@ class TetheredExplorer(Controller):
                                  f"{decision!r}")
             edge_rad, progress = decision.angle, 0.0
             steps = _nearest(leg.exits_m, decision.angle)
+            if self.leash is not None:
+                self.leash.new_leg()
         if steps is None:  # standing at a vertex between calls
             return Command(messages=out)
-        sense = c.direction(progress) if self.constrained else 1
-        if sense and self.constrained and not c.tether.may_step(steps[sense < 0], leg.around_m):
-            self._wanted, sense = steps[sense < 0], 0
+        if self.leash is None:
+            sense = 1
+        elif self.walls and vertex is None and self.leash.cut_off(leg.around_m):
+            sense = self.leash.undo(leg.around_m, was_back, lambda s: -s) or 0
+        else:
+            sense = c.direction(progress)
+            # the step off a vertex joins no trail: a retrace never walks back onto it
+            if sense and self.leash.check(sense, steps[sense < 0], leg.around_m, sense < 0,
+                                          progress == 0.0, reserve=False) is not None:
+                self._wanted, sense = steps[sense < 0], 0
         self._moved, self._back = sense != 0, sense < 0
         return Command(float(sense), 0.0, None, out, None, edge_rad,
                        called if vertex is not None else ())
@@ -172,7 +189,8 @@ class TetheredExplorer(Controller):
         c, leg, tick = self.connected, observation.leg, self._tick(observation)
         if self._back and leg.steps_m is None:  # the walk back reached the vertex
             c.arrived_back()
-        out = c.after(tick, self._wanted, self._moved, leg.around_m)
+        out = c.after(tick, self._wanted, self._moved, leg.around_m,
+                      cut=self.leash.cut_on_this_way(self._back))
         events = (Infeasible(),) if c.tether.stalled(tick) else ()
         return Command(messages=tuple(out), events=events)
 

@@ -1,5 +1,7 @@
-"""Connected exploration's leash on a body (ours): the moves a MuJoCo robot may make on
-its tether, and the walls its leash cannot know.
+"""Connected exploration's leash against walls (ours): the moves a robot may make on its
+tether, and the walls its leash cannot know; the same in both worlds (a MuJoCo robot's
+moves are its control ticks' ``(v, omega)``, a graph-world robot's its steps along its
+edge).
 
 The tether (:class:`~algorithms.exploration.tether.Tether`) knows ranges, not walls. A
 robot keeps the moves it made since its parents were last all in radio reach (its
@@ -17,8 +19,10 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from collections.abc import Callable, Sequence
+from typing import Any
+
 from algorithms.exploration.tether import Tether
-from algorithms.robot import Command
 
 
 class Leash:
@@ -26,7 +30,7 @@ class Leash:
 
     def __init__(self, tether: Tether) -> None:
         self.tether = tether
-        self._trail: list[tuple[float, float]] = []  # (v m/s, omega rad/s) since all linked
+        self._trail: list = []  # its moves since its parents were all linked
         self._occluded: set[int] = set()  # the ways (+1 on, -1 back) a wall cut a link
         self._cut: set = set()  # the parents whose links a wall cut
         self._parents_then = tether.parents
@@ -39,20 +43,20 @@ class Leash:
         """Whether a parent is missing from its radio neighbours ``around``."""
         return not all(q in around for q in self.tether.parents)
 
-    def check(self, command: Command, dt_s: float, around: Mapping, back: bool,
-              at_centre: bool) -> tuple[float, float] | None:
-        """The step (m, its own frame) the leash, or a wall met on this way, forbids of
-        ``command`` this control period (``dt_s``), or None: the command may go (and
-        joins the trail). ``back``: it walks back along its leg; ``at_centre``: it stands
-        on a vertex centre, where nothing is backed out of."""
+    def check(self, move: Any, step: Sequence[float], around: Mapping, back: bool,
+              at_centre: bool, reserve: bool = True) -> Sequence[float] | None:
+        """The ``step`` (m, the robot's displacement) of ``move`` that the leash, or a wall
+        met on this way, forbids, or None: the move may go, and joins the trail (``move``
+        None: the robot stays). ``back``: it walks back along its leg (and, with
+        ``reserve``, may use the tether's reserve); ``at_centre``: it stands on a vertex
+        centre, where nothing is backed out of."""
         wanted = None
-        if command.v_m_s != 0.0:
-            step = (command.v_m_s * dt_s, 0.0)
+        if move is not None:
             if self._way(back) in self._occluded or not self.tether.may_step(
-                    step, around, back=back):
+                    step, around, back=back and reserve):
                 wanted = step
             else:
-                self._trail.append((command.v_m_s, command.omega_rad_s))
+                self._trail.append(move)
         if at_centre:
             self._trail = []
         if self.tether.parents != self._parents_then:  # a new parent: try again
@@ -64,15 +68,14 @@ class Leash:
         """The parents a wall cut it from on the way it drives (empty if none)."""
         return self._cut if self._way(back) in self._occluded else ()
 
-    def undo(self, around: Mapping, back: bool) -> tuple[float, float] | None:
+    def undo(self, around: Mapping, back: bool, reverse: Callable[[Any], Any]) -> Any:
         """A parent's link is gone: this way is closed, and the last move of its trail
-        reversed (``(v m/s, omega rad/s)``), or None when nothing is left to undo."""
+        comes back reversed (``reverse(move)``), or None when nothing is left to undo."""
         self._occluded.add(self._way(back))
         self._cut |= {q for q in self.tether.parents if q not in around}
         if not self._trail:
             return None
-        v, w = self._trail.pop()
-        return -v, -w
+        return reverse(self._trail.pop())
 
     def forget(self) -> None:
         """Forget its trail (it gave up a vertex area: it never backs into it)."""

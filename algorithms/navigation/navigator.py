@@ -454,31 +454,28 @@ class Navigator:
     def _own_lane(self, angle: float):
         """Leaving along ``angle``: whether the strips the line sensors see now include
         the lane sought (the left lane of that edge) rather than a lane of a neighbouring
-        edge of this vertex (ours). Lanes start where they no longer cross
-        their neighbours' (:func:`mjswarm.arena.geometry.lane_setback`), at 27 cm for
-        edges 45 degrees apart, and there the right lane of the edge 45 degrees to the
-        left comes within 2.5 cm of the lane sought: a robot set off 2.4 degrees off its
-        edge found that lane's corner with its left sensor first and followed it
-        (``wheel:4@8``, 1 robot, 0.1 m/s, line noise 0.5 mm, kinematic, seed 0: lost).
-        A sensor's strip counts as the lane sought when that lane's line is the nearest
+        edge of this vertex (ours). Lanes start where they no longer cross their
+        neighbours' (:func:`mjswarm.arena.geometry.lane_setback`), at 27 cm for edges 45
+        degrees apart, where the right lane of the edge 45 degrees to the left comes
+        within 2.5 cm of the lane sought: a robot set off 2.4 degrees off its edge found
+        that lane's corner with its left sensor first and followed it (``wheel:4@8``, 1
+        robot, 0.1 m/s, line noise 0.5 mm, kinematic, seed 0: lost). A sensor's strip counts as the lane sought when that lane's line is the nearest
         of the vertex's lane lines (both lanes of every edge measured here, on the
         robot's side of the centre; positions by odometry from the centre it left). A
         sensor on the lane sought lies within half a strip (15 mm) of its line, and the
         nearest other lane line is about 4 cm away where that lane starts (edges 45 or 60
         degrees apart; 7 cm at 90, and farther beyond the start), so the check errs only
         when the robot's estimate of where the sensor is errs by 5-20 mm across the lane
-        (5 mm for a sensor on the strip's edge nearest the other line); noise-free runs
-        keep their results (main-job digest and stress grid unchanged). The spokes of the
+        (5 mm for a sensor on the strip's edge nearest the other line). The spokes of the
         vertex's edges (centre-line strips from ``spoke_inner_radius_m`` to
         ``spoke_radius_m``) are among the other lines, as segments: where edges meet at 45
-        degrees the right sensor ends the sidestep about 5 mm beside the outer end of
-        the spoke 45 degrees to the left, and with odometry a few millimetres and a degree
-        off it saw that spoke, 9 cm short of where the lane sought starts, and followed it
-        off the vertex (``wheel:4@8``, 4 robots, 0.1 m/s, every noise with slip 0.05,
-        kinematic, seed 1: lost). So the lane sought counts only from a strip's width
-        short of ``lane_start_m`` along its edge (no lane starts nearer), where a sensor on
-        it is at least 10 cm from any spoke: neither rule changes what a robot on its lane
-        finds. None without the sensor spacing."""
+        degrees the right sensor ends the sidestep about 5 mm beside the outer end of the
+        spoke 45 degrees to the left, and with odometry a few millimetres and a degree off
+        it saw that spoke, 9 cm short of where the lane sought starts, and followed it off
+        the vertex (``wheel:4@8``, 4 robots, 0.1 m/s, every noise with slip 0.05,
+        kinematic, seed 1: lost). So the lane sought counts only from a strip's width short
+        of ``lane_start_m`` along its edge (no lane starts nearer), where a sensor on it is
+        at least 10 cm from any spoke. None without the sensor spacing."""
         spacing = self.cal.line_spacing_m
         others = [a for a in self.edge_angles if abs(wrap(a - angle)) > MIN_EDGE_GAP / 2.0]
         if spacing is None or not others:

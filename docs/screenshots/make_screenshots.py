@@ -27,7 +27,7 @@ RUNS = {
     "main_job": ["explore", "--arena", "arena2", "--robots", "4"],
     "fig9_graph": ["explore", "--world", "graph", "--arena", "fig9", "--robots", "2"],
     "fig9_connected": ["explore", "--world", "graph", "--arena", "fig9", "--robots", "3",
-                       "--radio-range", "1.5", "--connectivity", "connected"],
+                       "--radio-range", "2", "--connectivity", "connected"],
     "patrol": ["experiment", "patrol", "--world", "point", "--robots", "8",
                "--steps", "400"],
     "coverage": ["experiment", "biconnected-coverage", "--cr", "2", "--world", "point",

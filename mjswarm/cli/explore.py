@@ -50,8 +50,10 @@ def run_graph(args) -> dict:
                                  seed=args.seed, max_time=args.max_time,
                                  edge_time=args.edge_time or "unit",
                                  radio_range_m=args.radio_range,
-                                 connectivity=args.connectivity, functions=functions)
-    return {"world": "graph", **result.to_dict(),
+                                 connectivity=args.connectivity, functions=functions,
+                                 radio_walls=args.radio_model != "open")
+    radio = {"radio_model": args.radio_model or "walls"} if args.radio_range else {}
+    return {"world": "graph", **result.to_dict(), **radio,
             **({"recording": args.record} if args.record else {})}
 
 
@@ -198,7 +200,8 @@ def register(subparsers) -> None:
                         action=number(above=0, most=MAX_RANGE_M,
                                       why="m; a longer range reaches no further in any arena"),
                         help="radio range, m. Graph world: robots and a base at the root "
-                             "talk within it (walls ignored), and the result reports "
+                             "talk within it where the arena's walls do not come between "
+                             "them (--radio-model), and the result reports "
                              "messages and the share of time every robot had a route to "
                              "the base. Embodied world: walls block; the robots keep "
                              "Le et al.'s connectivity tables while they move and the result "
@@ -209,6 +212,10 @@ def register(subparsers) -> None:
                         help="give up after T: graph world time units (default: "
                              "50 (E + 1) + 100); embodied simulated seconds (default: 3600)")
     graph = parser.add_argument_group("graph world")
+    graph.add_argument("--radio-model", default=None, choices=("walls", "open"),
+                       help="with --radio-range: 'walls' (default): a link needs line of "
+                            "sight past the arena's walls, the base's antenna on its 1 m "
+                            "mast, as on the MuJoCo robots; 'open': range alone")
     graph.add_argument("--edge-time", default=None, choices=EDGE_TIMES,
                        help="time to traverse an edge: 'unit' (1 step each, as in the "
                             "paper) or 'length' (length / mean edge length) (default: unit)")
@@ -282,8 +289,14 @@ def check_options(args) -> None:
             raise MjswarmError(f"{', '.join(given)} "
                                f"{'applies' if len(given) == 1 else 'apply'} only to the "
                                "embodied world (--world embodied)")
-    elif args.edge_time is not None:
-        raise MjswarmError("--edge-time applies only to the graph world (--world graph)")
+    else:
+        given = [flag for flag, value in (("--edge-time", args.edge_time),
+                                          ("--radio-model", args.radio_model)) if value]
+        if given:
+            raise MjswarmError(f"{', '.join(given)} {'applies' if len(given) == 1 else 'apply'}"
+                               " only to the graph world (--world graph)")
+    if args.radio_model is not None and args.radio_range is None:
+        raise MjswarmError("--radio-model needs --radio-range")
     if args.connectivity not in (None, "none"):
         if args.radio_range is None:
             raise MjswarmError(f"--connectivity {args.connectivity} needs --radio-range")
@@ -351,7 +364,10 @@ def summary(result: dict) -> str:
         lines = [head, f"not completed ({why}): no robot declared completion", traversals]
     if "radio_range_m" in result:
         lines.append(
-            f"radio {result['radio_range_m']:g} m, connectivity {result['connectivity']}: "
+            f"radio {result['radio_range_m']:g} m"
+            f"{' (walls block)' if result.get('radio_model') == 'walls' else ''}"
+            f"{' (range alone)' if result.get('radio_model') == 'open' else ''}, "
+            f"connectivity {result['connectivity']}: "
             f"{result['messages']} messages, {result['relay_trips']} relay trips; every "
             f"robot reached the base in {100 * result['connected_share']:.1f} % of the "
             f"ticks, the team with the base was biconnected in "

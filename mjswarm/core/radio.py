@@ -73,6 +73,12 @@ if TYPE_CHECKING:  # the embodied worlds' radio model (sight_blocker) asks the s
 #: every id is an int, else objects), a bool array with one entry per pair, True when i and
 #: j cannot hear each other (no line of sight).
 Blocker = Callable[[np.ndarray], np.ndarray]
+#: A robot's radio antenna above the floor (m), where the line-of-sight rays start and
+#: end: above the wheels (0.05 m), inside the chassis (0.012..0.07 m).
+ANTENNA_HEIGHT_M = 0.06
+#: Height (m) of the base station's antenna at the root: above the robots (0.07 m tall),
+#: so that a robot standing on the root does not shadow the others; walls still block.
+BASE_MAST_M = 1.0
 
 # ------------------------------------------------------------------ immutable payloads
 _ATOM, _SEQUENCE, _FIELDS, _HANDLE = range(4)
@@ -146,6 +152,16 @@ def _check_options(range_m: float | None, edges, drop_prob: float) -> None:
         raise MjswarmError(f"radio: drop probability must be in [0, 1), got {drop_prob}")
 
 
+def _id_array(robots: Sequence[Hashable]) -> np.ndarray:
+    """The robot ids as an array: int64 when every id is an int, else objects."""
+    if all(isinstance(r, (int, np.integer)) for r in robots):
+        return np.array(robots, dtype=np.int64)
+    ids = np.empty(len(robots), dtype=object)
+    for k, r in enumerate(robots):
+        ids[k] = r
+    return ids
+
+
 class Radio:
     """Broadcast radio with range d_c (or explicit links), one-tick latency, drops, counters.
 
@@ -176,12 +192,7 @@ class Radio:
     ) -> None:
         self.robots: tuple[Hashable, ...] = tuple(robots)
         self._index: dict[Hashable, int] = {r: k for k, r in enumerate(self.robots)}
-        if all(isinstance(r, (int, np.integer)) for r in self.robots):
-            self._ids = np.array(self.robots, dtype=np.int64)
-        else:
-            self._ids = np.empty(len(self.robots), dtype=object)
-            for k, r in enumerate(self.robots):
-                self._ids[k] = r
+        self._ids = _id_array(self.robots)
         if len(self._index) != len(self.robots):
             raise MjswarmError("radio: duplicate robot ids")
         _check_options(range_m, edges, drop_prob)

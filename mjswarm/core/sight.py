@@ -1,6 +1,6 @@
 """Line of sight between robots: cast once per world state, shared by every sensor.
 
-Robot ``k`` sees robot ``p`` when a ray from ``k``'s centre at ``RAY_HEIGHT_M``, towards
+Robot ``k`` sees robot ``p`` when a ray from ``k``'s centre at ``ANTENNA_HEIGHT_M``, towards
 ``p``'s centre, hits ``p`` first; only collision geoms (``COLLISION_GROUP``: robots, walls, the floor) block.
 The bearing sensor (:mod:`mjswarm.core.bearing`) asks this for the ordered pairs in its field of
 view, the radio (:func:`mjswarm.core.radio.sight_blocker`) for every pair in range
@@ -25,13 +25,13 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from mjswarm.core.radio import ANTENNA_HEIGHT_M
 from mjswarm.core.raycast import Rays
 from mjswarm.core.world import COLLISION_GROUP
 
 if TYPE_CHECKING:
     from mjswarm.core.simulation import Simulation
 
-RAY_HEIGHT_M = 0.06  # above the wheels (0.05 m), inside the chassis (0.012..0.07 m)
 #: ``mj_ray``'s group filter: only collision geoms block line of sight.
 _COLLISION = (np.arange(mujoco.mjNGROUP) == COLLISION_GROUP).astype(np.uint8)
 
@@ -49,7 +49,7 @@ class LineOfSight:
         self._seen = np.empty(0, bool)
         self.rays_cast = 0  #: rays cast so far (each ordered pair once per state)
         #: one ray's start and direction (m) and first geom, for :meth:`_cast_each`
-        self._ray = (np.array([0.0, 0.0, RAY_HEIGHT_M]), np.zeros(3), np.empty(1, np.int32))
+        self._ray = (np.array([0.0, 0.0, ANTENNA_HEIGHT_M]), np.zeros(3), np.empty(1, np.int32))
 
     def __call__(self, k: np.ndarray, p: np.ndarray) -> np.ndarray:
         n = self.sim.n
@@ -80,15 +80,15 @@ class LineOfSight:
         return self._seen[where]
 
     def from_point(self, point: tuple[float, float], robots: np.ndarray,
-                   height_m: float = RAY_HEIGHT_M) -> np.ndarray:
+                   height_m: float = ANTENNA_HEIGHT_M) -> np.ndarray:
         """Whether each robot is seen from a fixed antenna at ``point`` (m), ``height_m``
         above the floor (a base station's mast): a ray from the antenna towards the robot's
-        centre at ``RAY_HEIGHT_M`` must hit the robot first; nothing is excluded."""
+        centre at ``ANTENNA_HEIGHT_M`` must hit the robot first; nothing is excluded."""
         sim = self.sim
         robots = np.asarray(robots, np.int64)
         poses = sim.poses()
         start = np.array([point[0], point[1], height_m], float)
-        vec = np.column_stack([poses[robots, :2], np.full(len(robots), RAY_HEIGHT_M)]) - start
+        vec = np.column_stack([poses[robots, :2], np.full(len(robots), ANTENNA_HEIGHT_M)]) - start
         dist = np.linalg.norm(vec, axis=1)
         unit = vec / np.where(dist > 0, dist, 1.0)[:, None]
         unit[dist == 0] = (1.0, 0.0, 0.0)
@@ -120,7 +120,7 @@ class LineOfSight:
         unit = np.zeros((len(k), 3))
         unit[:, 0], unit[:, 1] = dx / scale, dy / scale
         unit[~apart, 0] = 1.0
-        start = np.full((len(k), 3), RAY_HEIGHT_M)
+        start = np.full((len(k), 3), ANTENNA_HEIGHT_M)
         start[:, 0], start[:, 1] = x[k], y[k]
         geom = self._first_geoms(k, start, unit, dist, sim.robot_bodies[k])
         return apart & (geom >= 0) & (sim.geom_robot[geom] == p)

@@ -24,9 +24,6 @@ TETHER_MARGIN_M = 0.02
 #: sidesteps two lane offsets across its edge, with room for the odometry's back-up to
 #: where its lane ended.
 TURN_RESERVE_M = 2 * LANE_OFFSET_M + 0.02
-#: Height (m) of the base station's antenna at the root: above the robots (0.07 m tall),
-#: so that a robot standing on the root does not shadow the others; walls still block.
-BASE_MAST_M = 1.0
 #: What pictures of a run say the marked vertices are.
 BEACON_LABEL = "beacon dropped (vertex explored)"
 #: Default stall timeout: at least this long (s), and at least STALL_EDGE_FACTOR times

@@ -103,12 +103,11 @@ from algorithms.exploration.tether import (
 from mjswarm.arena import ArenaSpec
 from mjswarm.arena.builder import arena_world_spec
 from mjswarm.core.bearing import BearingSensor
-from mjswarm.core.radio import Radio, Uplink, sight_blocker
+from mjswarm.core.radio import BASE_MAST_M, Radio, Uplink, sight_blocker
 from mjswarm.core.simulation import Simulation
 from mjswarm.errors import RunInterrupted
 from mjswarm.experiments.awareness import BeliefSampling, TetherTruth
 from mjswarm.experiments.embodied import (  # noqa: F401 - the experiment's public names
-    BASE_MAST_M,
     BEACON_LABEL,
     TETHER_MARGIN_M,
     TURN_RESERVE_M,

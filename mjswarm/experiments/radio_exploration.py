@@ -56,6 +56,7 @@ from algorithms.exploration.tether import (
     docked,
     initial_parents,
 )
+from mjswarm.core.radio import BASE_MAST_M
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.graph_exploration import default_max_time
 from mjswarm.experiments.minds import strategy_name
@@ -182,10 +183,12 @@ class ConnectedExploration(LoopFunctions):
 
 
 def connected_controllers(minds: Sequence[Strategy], radio_range_m: float,
-                          connectivity: str, report: bool = False) -> dict:
+                          connectivity: str, report: bool = False,
+                          walls: bool = False) -> dict:
     """The controllers of a run: a tethered explorer around each mind (robot 0 docked at
     the base under ``biconnected``, rule 1 of the tether) and, under a constraint, the
-    base station (``BASE``); with ``report`` the explorers report their vertex calls."""
+    base station (``BASE``); with ``report`` the explorers report their vertex calls; with
+    ``walls`` they know that walls may cut their links."""
     need, constrained = NEED.get(connectivity, 1), connectivity != "none"
     controllers = {BASE: FixedNode(BaseStation(Flooder()))} if constrained else {}
     for i, mind in enumerate(minds):
@@ -194,7 +197,7 @@ def connected_controllers(minds: Sequence[Strategy], radio_range_m: float,
             continue
         tether = Tether(i, radio_range_m, initial_parents(i, need), ticks_per_unit=TICKS_PER_UNIT)
         controllers[i] = TetheredExplorer(ConnectedExplorer(i, mind, tether), constrained,
-                                          report)
+                                          report, walls)
     return controllers
 
 
@@ -202,21 +205,26 @@ def run_connected(world: GraphWorld, minds: list[Strategy], radio_range_m: float
                   connectivity: str = "connected", *, seed: int | None = None,
                   max_time: float | None = None, arena: str = "<graph>",
                   functions: Sequence[LoopFunctions] = (),
-                  report: bool = False) -> ConnectedExplorationResult:
+                  report: bool = False, walls: Sequence | None = None,
+                  mast_m: float = BASE_MAST_M) -> ConnectedExplorationResult:
     """Explore ``world``'s graph with ``minds`` (one per robot) from the root, with a
     radio of range ``radio_range_m`` (m), keeping ``connectivity`` (module docstring),
     until a declaration, rule 5's verdict or ``max_time`` time units (default: the graph
     world's); ``functions`` are more loop functions (a recording); with ``report`` the
-    robots report their vertex calls (for a recording)."""
+    robots report their vertex calls (for a recording); ``walls`` (the arena's corridor
+    walls, :func:`~mjswarm.arena.geometry.corridor_walls`) block links as they do the
+    MuJoCo robots' radio, the base's antenna ``mast_m`` above the root (None: the open
+    model, range alone)."""
     if connectivity not in CONNECTIVITY:
         raise MjswarmError(f"connectivity must be one of {', '.join(CONNECTIVITY)}, "
                            f"got '{connectivity}'")
-    radio_world = RadioGraphWorld(world, radio_range_m)
+    radio_world = RadioGraphWorld(world, radio_range_m, walls, mast_m)
     need_robots(connectivity, len(minds))
     radio_world.reset(len(minds), base=connectivity != "none", dock=NEED.get(connectivity) == 2)
     experiment = ConnectedExploration(radio_world, strategy_name(minds), connectivity,
                                       seed=seed, arena=arena)
-    loop = Loop(radio_world, connected_controllers(minds, radio_range_m, connectivity, report),
+    loop = Loop(radio_world, connected_controllers(minds, radio_range_m, connectivity, report,
+                                                   walls is not None),
                 [experiment, *functions])
     max_time = default_max_time(world) if max_time is None else max_time
     return loop.run(max_ticks=2 * math.floor(max_time * TICKS_PER_UNIT))[0]

@@ -35,7 +35,7 @@ def run_exploration(spec: ArenaSpec, robots: int,
                     max_time: float | None = None, edge_time: str = "unit",
                     radio_range_m: float | None = None, connectivity: str | None = None,
                     config=None, functions: Sequence[LoopFunctions] = (),
-                    progress: bool = False) -> ExplorationResult:
+                    progress: bool = False, radio_walls: bool = True) -> ExplorationResult:
     """Explore ``spec`` from its root with ``robots`` robots running ``strategy`` (a
     name from ``STRATEGIES`` or a factory) in ``world``.
 
@@ -45,7 +45,10 @@ def run_exploration(spec: ArenaSpec, robots: int,
     :class:`~mjswarm.experiments.exploration.EmbodiedConfig` (its radio, constraint and
     time limit are set from the arguments above when given); ``functions``: more loop
     functions that watch the run (a recording, e.g. :class:`~mjswarm.outputs.
-    exploration_recording.ExplorationRecording`, a video); ``progress``: a progress display (embodied world).
+    exploration_recording.ExplorationRecording`, a video); ``progress``: a progress display (embodied world);
+    ``radio_walls``: in the graph world, the arena's walls block radio links as they do
+    the MuJoCo robots' (False: the open model, range alone; the embodied world's walls
+    always block).
     """
     if world not in WORLDS:
         raise MjswarmError(f"unknown world '{world}' (choose from {', '.join(WORLDS)})")
@@ -71,6 +74,8 @@ def run_exploration(spec: ArenaSpec, robots: int,
                          functions=functions, report=report)
     from mjswarm.experiments.radio_exploration import run_connected
 
+    from mjswarm.arena.geometry import corridor_walls
+
     return run_connected(graph, minds, radio_range_m, connectivity or "none", seed=seed,
                          max_time=max_time, arena=spec.name, functions=functions,
-                         report=report)
+                         report=report, walls=corridor_walls(spec) if radio_walls else None)

@@ -273,7 +273,8 @@ def noise_table(rows: list[tuple[StressRun, EmbodiedResult, float]]) -> str:
     return "\n".join(lines)
 
 
-def main(argv: list[str] | None = None) -> int:
+def parser() -> argparse.ArgumentParser:
+    """The command line of ``python -m mjswarm.experiments.stress``."""
     parser = argparse.ArgumentParser(
         prog="python -m mjswarm.experiments.stress",
         description="Run the robustness stress grid and print its table (markdown); "
@@ -306,15 +307,20 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--only-slip", action="store_true",
                         help="with --noise: only the levels with wheel slip (alone, and "
                              "with every noise together)")
-    args = parser.parse_args(argv)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    command = parser()
+    args = command.parse_args(argv)
     if args.noise + args.dense + args.dead > 1:
-        parser.error("choose one of --noise, --dense and --dead")
+        command.error("choose one of --noise, --dense and --dead")
     if (args.only_slip or args.slip != GRID_SLIP) and not args.noise:
-        parser.error("--slip and --only-slip need --noise")
+        command.error("--slip and --only-slip need --noise")
     if args.sample and not (args.noise or args.dense):
-        parser.error("--sample needs --noise or --dense")
+        command.error("--sample needs --noise or --dense")
     if not 0.0 <= args.slip < 1.0:
-        parser.error(f"--slip must be in [0, 1), got {args.slip:g}")
+        command.error(f"--slip must be in [0, 1), got {args.slip:g}")
     if args.noise:
         arenas = NOISE_ARENAS if args.arenas is None else args.arenas.split(",")
         levels = tuple(n for n in noises(args.slip) if n.wheel_slip or not args.only_slip)

@@ -622,14 +622,7 @@ class Recorder:
         beliefs = dict(beliefs or {})
         ids = [robot_name(i) for i in range(n)]
         labels = [f"{ids[i]}: {beliefs[i]}" if i in beliefs else ids[i] for i in range(n)]
-        truths = (None if truth is None else
-                  dict(truth) if isinstance(truth, Mapping) else dict.fromkeys(range(n), truth))
-        if truths is None:
-            colors = [robot_color(i) for i in range(n)]
-        else:
-            colors = [_NO_BELIEF_COLOR if i not in beliefs
-                      else _AGREE_COLOR if beliefs[i] == truths.get(i) else _DISAGREE_COLOR
-                      for i in range(n)]
+        colors = _belief_colors(n, beliefs, truth)
         xy = self._positions()
         fixed = dict(fixed or {})
         pairs = [(ids[a], ids[b]) for a, b in edges] + [(ids[a], f) for a, f in fixed_links]
@@ -745,6 +738,50 @@ def graph_bounds(bounds_m: tuple[float, float, float, float], scale: float,
                               y_range=[-scale * (y1 + margin_m), -scale * (y0 - margin_m)])
 
 
+def _belief_colors(n: int, beliefs: Mapping[int, str],
+                   truth: str | Mapping[int, str] | None) -> list:
+    """Each robot's colour in the radio graph: its own without a ``truth``; else green
+    where its belief equals the truth, red where it differs, grey without a belief."""
+    if truth is None:
+        return [robot_color(i) for i in range(n)]
+    truths = dict(truth) if isinstance(truth, Mapping) else dict.fromkeys(range(n), truth)
+    return [_NO_BELIEF_COLOR if i not in beliefs
+            else _AGREE_COLOR if beliefs[i] == truths.get(i) else _DISAGREE_COLOR
+            for i in range(n)]
+
+
+def _map_views(robots: list[str], frame) -> list:
+    """Each robot's map over its incidence matrix, one tab each (all maps in one view
+    above :data:`MAP_TAB_LIMIT` robots), every graph in the arena's ``frame``."""
+    if len(robots) > MAP_TAB_LIMIT:
+        return [rrb.GraphView(name="maps", origin="/map", visual_bounds=frame)]
+    return [rrb.Vertical(rrb.GraphView(name=f"map {r}", origin=f"/map/{r}",
+                                       visual_bounds=frame),
+                         rrb.TextDocumentView(name=f"incidence matrix {r}",
+                                              origin=f"/matrices/{r}"),
+                         name=r, row_shares=[3, 2]) for r in robots]
+
+
+def _series_views(robots: list[str], maps: bool, sensors: bool) -> rrb.Tabs:
+    """The time series: controller state and telemetry (state first in runs with maps),
+    speeds, and the sensors when recorded."""
+    def plot(name: str, leaf: str) -> rrb.TimeSeriesView:
+        return rrb.TimeSeriesView(name=name, origin="/robots",
+                                  contents=[f"+ /robots/{r}/{leaf}" for r in robots])
+
+    states = [rrb.StateTimelineView(name="controller state", origin="/states"),
+              plot("telemetry", "state/**")]
+    return rrb.Tabs(
+        *(states if maps else states[::-1]),
+        plot("speed (m/s)", "speed"),
+        *([plot("line sensors (m)", "sensors/line"),
+           plot("IR (m)", "sensors/ir"),
+           plot("bearings (rad)", "bearings/**"),
+           plot("encoders (rad)", "sensors/encoders"),
+           plot("battery (V)", "battery")] if sensors else []),
+    )
+
+
 def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
                trail_window_s: float, radio: bool, sensors: bool,
                video: bool = False, scale: float = 1.0, maps: bool = True) -> rrb.Blueprint:
@@ -753,8 +790,8 @@ def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
     robots in their colours with their headings and trails, radio links) over the event
     log; on the right, one tab per robot with its explored graph over the incidence
     matrix it carries (all graphs in one view above :data:`MAP_TAB_LIMIT` robots) and
-    the beacons, for runs on an arena (``maps``), and the radio graph, over the time series (controller state, speeds, and
-    the sensors when recorded). The blueprint, selection and time panels start
+    the beacons, for runs on an arena (``maps``), and the radio graph, over the time
+    series (controller state, speeds, and the sensors when recorded). The blueprint, selection and time panels start
     collapsed (the time panel to its one-line bar)."""
     robots = [robot_name(i) for i in range(n_robots)]
     trail_range = rrb.VisibleTimeRanges(rrb.VisibleTimeRange(
@@ -771,37 +808,12 @@ def _blueprint(bounds_m: tuple[float, float, float, float], n_robots: int,
         eye_controls=top_down_eye(bounds_m),
         line_grid=rrb.LineGrid3D(visible=False),
     )
-    frame = graph_bounds(bounds_m, scale)  # every graph in the arena's frame
-    if not maps:
-        maps = []
-    elif n_robots <= MAP_TAB_LIMIT:
-        maps = [rrb.Vertical(rrb.GraphView(name=f"map {r}", origin=f"/map/{r}",
-                                           visual_bounds=frame),
-                             rrb.TextDocumentView(name=f"incidence matrix {r}",
-                                                  origin=f"/matrices/{r}"),
-                             name=r, row_shares=[3, 2]) for r in robots]
-    else:
-        maps = [rrb.GraphView(name="maps", origin="/map", visual_bounds=frame)]
+    maps = _map_views(robots, graph_bounds(bounds_m, scale)) if maps else []
     radio_views = [rrb.GraphView(name="radio", origin="/radio/graph"),
                    rrb.TextDocumentView(name="radio truth", origin="/radio/truth")]
     beacons = [rrb.TextDocumentView(name="beacons", origin="/beacons")] if maps else []
     graphs = [*maps, *beacons, *(radio_views if radio else [])]
-
-    def plot(name: str, leaf: str) -> rrb.TimeSeriesView:
-        return rrb.TimeSeriesView(name=name, origin="/robots",
-                                  contents=[f"+ /robots/{r}/{leaf}" for r in robots])
-
-    states = [rrb.StateTimelineView(name="controller state", origin="/states"),
-              plot("telemetry", "state/**")]
-    series = rrb.Tabs(
-        *(states if maps else states[::-1]),
-        plot("speed (m/s)", "speed"),
-        *([plot("line sensors (m)", "sensors/line"),
-           plot("IR (m)", "sensors/ir"),
-           plot("bearings (rad)", "bearings/**"),
-           plot("encoders (rad)", "sensors/encoders"),
-           plot("battery (V)", "battery")] if sensors else []),
-    )
+    series = _series_views(robots, bool(maps), sensors)
     if video:
         scene = rrb.Horizontal(scene, rrb.Spatial2DView(name="camera", origin="/camera"))
     return rrb.Blueprint(

@@ -34,6 +34,7 @@ root, stepped by the loop as a fixed node.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -41,10 +42,12 @@ from algorithms.exploration import Beacon
 from algorithms.exploration.base import BeaconHandle
 from algorithms.exploration.tether import BASE
 from algorithms.robot import NOTHING, Command, LegSense, Observation, VertexSense
+from mjswarm.arena.geometry import Wall
 from mjswarm.core.radio import Radio
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.graphworld import GraphWorld
 from mjswarm.worlds.loop import World
+from mjswarm.worlds.wall_sight import wall_blocker
 
 #: Control ticks per time unit (one edge in the unit-time graph world).
 TICKS_PER_UNIT = 10
@@ -56,16 +59,23 @@ MOVE, ANSWER = "move", "answer"
 
 class RadioGraphWorld(World):
     """``graph``'s vertices and edges, with a base at the root and a radio of range
-    ``radio_range_m`` (m); :meth:`reset` starts a run (one world serves many runs)."""
+    ``radio_range_m`` (m); :meth:`reset` starts a run (one world serves many runs). With
+    ``walls`` (the arena's corridor walls) a link needs line of sight past them, the
+    base's antenna ``mast_m`` above the root (:mod:`~mjswarm.worlds.wall_sight`: the
+    question the MuJoCo robots' radio answers); without, range alone decides."""
 
     #: one tick (time units): the loop steps it in two phases
     control_dt_s = 1 / TICKS_PER_UNIT
 
-    def __init__(self, graph: GraphWorld, radio_range_m: float) -> None:
+    def __init__(self, graph: GraphWorld, radio_range_m: float,
+                 walls: Sequence[Wall] | None = None, mast_m: float = 0.0) -> None:
         if not (math.isfinite(radio_range_m) and radio_range_m > 0):
             raise MjswarmError(f"radio range must be a positive number of metres, got {radio_range_m}")
         self.graph = graph
         self.range_m = radio_range_m
+        #: the arena's walls, which block links (:mod:`~mjswarm.worlds.wall_sight`), and
+        #: the base's antenna height (m); None: links by range alone (the open model)
+        self.walls, self.mast_m = walls, mast_m
         self.pos = {v: np.array(p, float) for v, p in graph.pos.items()}
         #: edge (v, u) -> its vector from v to u (m), and the share of it a tick covers
         self._vector = {(v, u): (graph.pos[u][0] - graph.pos[v][0],
@@ -103,7 +113,10 @@ class RadioGraphWorld(World):
         self._robot_out: list = []
         self._node_out: list = []
         self.radio = None
-        self.attach_radio(Radio([*range(n_robots), *self.fixed], range_m=self.range_m))
+        blocked = None if self.walls is None else wall_blocker(
+            self.walls, self._xy, dict.fromkeys([*self.fixed, *self.docked], self.mast_m))
+        self.attach_radio(Radio([*range(n_robots), *self.fixed], range_m=self.range_m,
+                                blocked=blocked))
 
     # -- the World surface ---------------------------------------------------------------
     @property

@@ -1,0 +1,77 @@
+"""The radio graph world's line of sight against walls (mjswarm.worlds.wall_sight) answers
+as the MuJoCo robots' radio does, and keeps connected exploration's promise."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from algorithms.exploration.tether import BASE
+from mjswarm.arena import load_arena
+from mjswarm.arena.builder import arena_world_spec
+from mjswarm.arena.geometry import corridor_walls
+from mjswarm.core.radio import BASE_MAST_M, sight_blocker
+from mjswarm.core.simulation import Simulation
+from mjswarm.core.world import Pose2D
+from mjswarm.experiments.minds import make_minds
+from mjswarm.experiments.radio_exploration import run_connected
+from mjswarm.worlds.graphworld import GraphWorld
+from mjswarm.worlds.wall_sight import wall_blocker
+
+
+def on_edges(spec, rng, n: int) -> np.ndarray:
+    """``n`` points on the arena's edges' centre lines (where the graph world's robots
+    travel), m."""
+    edges = [spec.edges[k] for k in rng.integers(len(spec.edges), size=n)]
+    t = rng.random(n)[:, None]
+    a = np.array([spec.vertices[u] for u, _ in edges])
+    b = np.array([spec.vertices[v] for _, v in edges])
+    return a + t * (b - a)
+
+
+@pytest.mark.parametrize("arena", ["arena2", "hex:2x2"])
+def test_walls_block_the_links_mujoco_blocks(arena):
+    """Two MuJoCo robots put down at random points of the edges (at least two body
+    diameters apart) hear each other exactly when the wall sight says they do, and the
+    base's mast sees a robot exactly when MuJoCo's ray from the mast does."""
+    spec, rng = load_arena(arena), np.random.default_rng(0)
+    sim = Simulation(arena_world_spec(spec, [Pose2D(9.0, 9.0), Pose2D(-9.0, -9.0)]))
+    mujoco_cut, root = sight_blocker(sim), spec.vertices[spec.root]
+    walls, where = corridor_walls(spec), {}
+    ours = wall_blocker(walls, where, {BASE: BASE_MAST_M})
+    points, agree, blocked = on_edges(spec, rng, 240).reshape(-1, 2, 2), 0, 0
+    for p, q in points:
+        if np.hypot(*(p - q)) < 0.3:
+            continue
+        sim.place_robot(0, Pose2D(*p))
+        sim.place_robot(1, Pose2D(*q))
+        where.update({0: p, 1: q, BASE: root})
+        theirs = bool(mujoco_cut(np.array([[0, 1]]))[0])
+        assert bool(ours(np.array([[0, 1]], object))[0]) == theirs, (p, q)
+        mast = not sim.sight.from_point(root, [0], BASE_MAST_M)[0]
+        assert bool(ours(np.array([[BASE, 0]], object))[0]) == mast, p
+        agree, blocked = agree + 1, blocked + theirs + mast
+    assert agree > 80 and 0 < blocked < 2 * agree  # both answers occur
+
+
+def test_two_fixed_nodes_always_link_and_an_open_line_is_never_blocked():
+    spec = load_arena("arena2")
+    walls = corridor_walls(spec)
+    root = spec.vertices[spec.root]
+    where = {BASE: root, 0: root, 1: spec.vertices["v2"]}
+    cut = wall_blocker(walls, where, {BASE: BASE_MAST_M, 0: BASE_MAST_M})
+    assert not cut(np.array([[BASE, 0]], object)).any()
+    assert not wall_blocker([], where, {})(np.array([[0, 1]], object)).any()
+
+
+def test_the_wall_aware_graph_world_keeps_every_robot_connected():
+    """With walls a connected team retraces a step that a wall cut (as the MuJoCo robots
+    do), so every robot keeps its route to the base in every tick; the walls cost it
+    relay trips and time against the open model."""
+    spec = load_arena("arena2")
+    world = GraphWorld(spec.graph(), spec.root)
+    walled = run_connected(world, make_minds("incidence-dfs", 4), 1.5, "connected",
+                           walls=corridor_walls(spec))
+    open_ = run_connected(world, make_minds("incidence-dfs", 4), 1.5, "connected")
+    assert walled.completed and walled.map_correct and walled.connected_share == 1.0
+    assert walled.relay_trips > open_.relay_trips and walled.makespan > open_.makespan
