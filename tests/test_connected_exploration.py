@@ -409,3 +409,13 @@ def test_embodied_connected_runs_are_deterministic():
     (poses_a, *rest_a), (poses_b, *rest_b) = run_once(), run_once()
     assert rest_a[2] >= 1  # the relay trip happened
     assert (poses_a == poses_b).all() and rest_a == rest_b
+
+
+def test_embodied_a_retrace_off_the_lanes_start_loses_nobody():
+    """hex:3x3, 6 robots at 3 m, 10 cm/s: R3 finds its lane at 270.00 s, a wall cuts its
+    parent's link two ticks later, and the leash's retrace backs its centre sensor off
+    the lane's start. Its navigator counts the retrace and keeps the lane: nobody stops
+    for good, with 0 contacts and every robot linked to the base in every tick."""
+    result = embodied("hex:3x3", 6, 3.0, speed_m_s=0.1, max_sim_time_s=280.0)
+    assert result.stopped_robots == []
+    assert result.collisions == 0 and result.cut_ticks == 0

@@ -12,8 +12,10 @@ from types import SimpleNamespace
 
 import pytest
 
-from algorithms.navigation import NavigatorState
+from algorithms.navigation import NavEvent, NavigatorState
+from algorithms.navigation.motions import SeekLine
 from algorithms.navigation.navigator import NAVIGATOR_TRANSITIONS, Corridor, Leg, Navigator
+from algorithms.navigation.percept import percept
 from mjswarm.core.simulation import Simulation
 from mjswarm.core.world import Pose2D, world_spec
 from mjswarm.worlds.navigation import calibration, conventions
@@ -163,3 +165,72 @@ def test_moves_outside_the_table_are_refused(body):
     nav._found_lane(FAILED)
     with pytest.raises(RuntimeError, match="cannot go from lost to scanning"):
         nav.begin_at_vertex()
+
+
+def test_a_strip_ends_only_ahead_of_where_the_centre_last_saw_it():
+    """:class:`~algorithms.navigation.motions.CentreEnd`: the centre off the strip for
+    ``END_CONFIRM_TICKS`` past where it was last on is the strip's end; off behind that
+    point (the robot driven backwards off the strip's start) is none, until the robot
+    has come forward past it."""
+    from algorithms.navigation.motions import END_CONFIRM_TICKS, CentreEnd
+
+    end = CentreEnd()
+    end.update(True, 1.000)
+    assert all(end.update(False, 1.000 - 0.002 * k) is None for k in range(1, 10))
+    assert end.update(False, 1.001) is None  # forward again: the count starts
+    found = [end.update(False, 1.001 + 0.002 * k) for k in range(1, END_CONFIRM_TICKS)]
+    assert found[-1] is not None and 1.000 < found[-1] < 1.002
+
+
+def test_a_lane_backed_off_its_start_by_the_leash_has_not_ended(body):
+    """hex:3x3, 6 robots at 3 m, connected, 0.1 m/s: R3 finds its lane at 270.00 s, a
+    wall cuts its parent's link two ticks later, and the leash's retrace drives it 7 mm
+    back (its navigator counting the ticks: :meth:`Navigator.carried`), its centre
+    sensor off the lane's start. Standing there for a new parent, its navigator keeps
+    the lane (a lane that ends with no corridor wall seen is not its lane: it would stop
+    for good), and once it drives on it follows the lane from its start."""
+    nav = Navigator(*body, 0.0, 0.1)
+    cal, dt = nav.cal, 0.02
+    wheels = [0.0, 0.0]
+
+    def tick(centre: bool, v: float | None = None, carried: bool = False):
+        """One control tick: the readings in, the wheels turned by the navigator's
+        command, or by ``v`` (m/s, straight; ``carried``: the leash drives it)."""
+        reading = [cal.line_floor_m] * 3
+        reading[1] -= 0.002 * centre  # a strip under the centre sensor
+        seen = percept(reading, (math.nan,) * 3, tuple(wheels), nav.line_filter)
+        if carried:
+            nav.carried(seen)
+            command = (v, 0.0)
+        else:
+            command = nav.update(seen)
+        speed, omega = command if v is None else (v, 0.0)
+        for side, sign in ((0, -1.0), (1, 1.0)):
+            wheels[side] += (speed + sign * omega * cal.track_m / 2.0) / cal.wheel_radius_m * dt
+        return command
+
+    for _ in range(20):  # on a centre: the line filter learns the floor
+        tick(False, 0.0)
+    nav.begin_at_vertex()
+    nav._scanned(SimpleNamespace(full_turn=None, start=0.0, swept=2 * math.pi,
+                                 mids=[0.0, math.pi]))
+    nav.depart(0.0)
+    for _ in range(2000):  # the sidestep, then the seek finds the lane
+        if nav.state is S.ON_EDGE:
+            break
+        tick(isinstance(nav._plan[0][0], SeekLine))
+    assert nav.state is S.ON_EDGE
+    for _ in range(2):
+        tick(True)
+    for k in range(6):  # the retrace: back off the lane's start
+        tick(k < 2, -0.1, carried=True)
+    for _ in range(50):  # it stands, the leash closed ahead of it
+        assert tick(False, 0.0)[0] > 0.0
+    assert nav.state is S.ON_EDGE and nav.events[-1].kind is not NavEvent.LOST
+    for _ in range(20):  # on again, to the lane's start
+        if nav.odometry.distance_m >= nav._lane._end._last_on_m:
+            break
+        tick(False)
+    for _ in range(10):
+        tick(True)
+    assert nav.state is S.ON_EDGE and nav.corridor is Corridor.BEFORE_WALL

@@ -26,7 +26,8 @@ It composes, fed only by its own observation:
   ranges, not walls: when a wall comes between it and a parent (the link is gone from its
   radio neighbours), it drives its moves since the link was last there backwards (never
   back into a vertex area it has given up, nor off a vertex centre it reached: moves from
-  before are forgotten), and then
+  before are forgotten; its navigator counts the moves backwards on its odometry, so
+  that its motion resumes from where the body is), and then
   stands as if the leash had stopped it (so it calls a relay, rule 6) until it has a new
   parent or sets out on a new leg; it may still walk back along its leg (rule 6), unless a
   wall cut a link on the way back too (ours). A step of a walk back may use the tether's
@@ -275,7 +276,7 @@ class Explorer(Controller):
                 self.connected.retire()  # it serves as nobody's relay
             return self._stand(now, out, around)
         if self.leash is not None and self.leash.cut_off(around):
-            command = self._retrace(now, out, around)
+            command = self._retrace(now, out, around, observation)
         else:
             command = self._drive(observation, out)
             if self.tether is None:
@@ -333,11 +334,15 @@ class Explorer(Controller):
         # serves it to the robot it granted the vertex, or is letting leave it)
         self._vertex_call(observation.beacon, observation.time_s, False, out, back=True)
 
-    def _retrace(self, now: int, out: list[Message], around) -> Command:
+    def _retrace(self, now: int, out: list[Message], around,
+                 observation: Observation) -> Command:
         """A parent's link is gone (a wall came between them: the leash knows ranges, not
         walls): drive its last moves backwards until the link is back, then wait for a new
         parent as if the leash had stopped it (on a vertex centre, at once: a robot backed
-        out of the centre it scans on would scan off it, find no beacon and stop)."""
+        out of the centre it scans on would scan off it, find no beacon and stop). Its
+        navigator counts these ticks on its odometry (:meth:`~algorithms.navigation.
+        Navigator.carried`), so that its motion resumes from where the body is."""
+        self.nav.carried(self._percept(observation))
         move = self.leash.undo(around, self.mode in RETURNING, lambda vw: (-vw[0], -vw[1]))
         if move is None:
             return self._stand(now, out, around)
@@ -356,8 +361,7 @@ class Explorer(Controller):
     def _drive(self, observation: Observation, out: list[Message]) -> Command:
         """Navigator, vertex calls, the speed rule and vertex entry: this tick's command."""
         nav, sense = self.nav, self._sense(out)
-        v, w = nav.update(percept(observation.line_m, observation.ir_m,
-                                  observation.encoder_rad, nav.line_filter))
+        v, w = nav.update(self._percept(observation))
         self._on_events(observation, out)
         if self.mode in TERMINAL:
             return Command(messages=tuple(out))
@@ -384,6 +388,11 @@ class Explorer(Controller):
             factor = speed / self.cruise_m_s
             v, w = v * factor, w * factor
         return Command(v, w, messages=tuple(out))
+
+    def _percept(self, observation: Observation):
+        """This tick's readings as its navigator reads them (its line filter)."""
+        return percept(observation.line_m, observation.ir_m, observation.encoder_rad,
+                       self.nav.line_filter)
 
     def _speed_rule(self, observation: Observation) -> float:
         """Its speed (m/s) by the rule on a lane (with the creep), S elsewhere."""

@@ -124,6 +124,11 @@ class CentreEnd:
     distance (m) half-way between the last tick with the centre on and the first tick
     off, once the centre has stayed off for ``END_CONFIRM_TICKS`` ticks (one noisy
     reading does not end a strip), else None.
+
+    A strip's end lies ahead: a tick off at an odometry distance short of where the
+    centre was last on is the robot driven backwards off the strip's start (the leash's
+    retrace, :meth:`~.navigator.Navigator.carried`), no end; the count starts again once
+    the robot has come forward past that point with the centre still off.
     """
 
     _last_on_m: float = 0.0
@@ -133,6 +138,9 @@ class CentreEnd:
     def update(self, centre: bool, distance_m: float) -> float | None:
         if centre:
             self._last_on_m, self._off_ticks = distance_m, 0
+            return None
+        if distance_m < self._last_on_m:  # backed off the strip's start: no end
+            self._off_ticks = 0
             return None
         if self._off_ticks == 0:
             self._left_at_m = (self._last_on_m + distance_m) / 2.0

@@ -367,6 +367,14 @@ class Navigator:
                 on_done(motion)
         return 0.0, 0.0
 
+    def carried(self, percept: Percept) -> None:
+        """One control tick in which its robot drives the body itself (the leash's
+        retrace: its last moves backwards, :class:`~algorithms.exploration.leash.Leash`):
+        its odometry counts the wheels' turns, and its plan waits. The motion under way
+        then resumes from where the body is, by odometry; a lane or spoke backed off its
+        strip's start has not ended (:class:`~.motions.CentreEnd`)."""
+        self.odometry.update(percept.encoders)
+
     @property
     def heading_variance(self) -> float:
         """Its own estimate of its heading's variance (rad^2) against the common frame:
