@@ -20,15 +20,24 @@ one; a completed column replaces a one-entry column). Matrices are never modifie
 and beacon share one object after a visit (Algorithm 4's ``In(vj) = In(Rk)``).
 :meth:`IncidenceMatrix.to_array` gives the dense matrix of the paper.
 
-Bit sets. The matrices merged during one exploration share a :class:`Numbering`, which
-gives every tag, every end and every (end, selecting robot) pair a bit position, in the
-order the team first wrote them. A matrix itself is a handful of integers used as bit sets
-(its known rows, their ends, the completed ends, the out ends, the selections), so
-Algorithm 1's union is a few ``|`` and the containment test a few ``&``, however large the
-matrix. A numbering is only a table of names, and only grows: what a matrix knows is what
-its bits say. ``rows``, ``completed`` and ``out`` are built from the bits when asked for,
-in numbering order (the order in which the team first wrote each entry). Matrices of
-different numberings (built directly, e.g. by a test) are merged after renumbering one.
+Bit sets. Each robot writes its matrices in a :class:`Numbering` of its own, which
+gives every tag and every end a bit position. A matrix itself is a handful of integers
+used as bit sets over those positions (its known rows, their ends, the completed ends, the
+out ends, the blocked ends) and, for the selections, one bit set of end positions for each
+robot of the team, so Algorithm 1's union (equations (2) and (3)) is a few ``|`` and the
+containment test a few ``&``, however large the matrix. A position is a function of who
+wrote the entry: robot ``r`` of a team of ``K`` writes its ``c``-th entry at ``c * K + r``,
+so the numberings of one team agree wherever they name the same entry and a matrix read
+from a teammate's beacon keeps its bits. A vertex's row (``I0(vj)`` of eq. (14), with the
+positions of its ends) is one immutable :class:`Row` value, made by the robot that drops
+the beacon and held by reference in every numbering that knows the vertex; eq. (5)'s
+negation by robot ``r`` sets the end's bit in ``r``'s selection set, whose place is the
+same in every numbering. Reading a teammate's matrix (:meth:`Numbering.learn`) copies
+into the robot's numbering only the rows and the other ends of completed ends new to it;
+nothing a numbering holds that can change is reachable from another robot. ``rows``,
+``completed`` and ``out`` are built from the bits when asked for, in numbering order.
+Matrices of numberings of no team (built directly, e.g. by a test) are merged after
+renumbering one.
 
 Blocked ends (ours: a body that cannot be passed). An end is *blocked* when
 the vertex at its far end is closed: a robot stopped for good in that vertex's area,
@@ -69,11 +78,13 @@ from types import MappingProxyType
 
 import numpy as np
 
-from algorithms.exploration.beacon_ids import parse_beacon_id
+from algorithms.exploration.beacon_ids import parse_beacon_id, robot_letters
 
 End = tuple[str, float]
 
 _NOBODY: frozenset[str] = frozenset()
+#: The most robots whose selections a numbering without owner records.
+_ANYONE = 26
 #: ``IncidenceMatrix._moved`` when every completed end has its first-written other end.
 _UNMOVED: Mapping[int, End] = MappingProxyType({})
 
@@ -114,22 +125,23 @@ class Row:
 
 
 class Numbering:
-    """Bit positions of the tags, ends and selections written by one robot's matrices, or
-    by matrices built directly (see the module docstring). Entries are added, never
-    changed or removed.
+    """Bit positions of the tags and ends written by one robot's matrices, or by matrices
+    built directly, and the slots of the robots' selections (see the module docstring).
+    Entries are added, never changed or removed.
 
     A *team* numbering (``owner``: the letters of the robot whose numbering it is, one of
     ``team`` robots) gives every entry a position that is a function of who wrote it, so
     that the numberings of one team agree wherever they name the same entry. Robot ``r``
     (0-based, :func:`~algorithms.exploration.beacon_ids.parse_beacon_id`) writes at the
-    positions ``c * team + r``: its tag of sequence ``s`` at ``c = s - 1``, its ``c``-th
-    selection at ``c``, and the ends of its rows in the order it drops them (the ``k``-th
-    end of a row at its ``base + k``, ``base`` being the number of ends of the robot's
-    earlier rows), so a vertex may have any number of edges. The dropping robot makes the
-    vertex's :class:`Row` record; a teammate learns it, with the selections it has not
-    seen, from the matrices it merges (:meth:`learn`). The paper does not say how the
-    columns are numbered. A numbering without owner numbers its entries in the order they
-    are written (a team of one).
+    positions ``c * team + r``: its tag of sequence ``s`` at ``c = s - 1`` and the ends of
+    its rows in the order it drops them (the ``k``-th end of a row at its ``base + k``,
+    ``base`` being the number of ends of the robot's earlier rows), so a vertex may have
+    any number of edges. Its selections are bit ``i`` of the ``r``-th of a matrix's
+    selection sets, ``i`` being the selected end. The dropping robot makes the vertex's
+    :class:`Row` record; a teammate learns it from the matrices it merges (:meth:`learn`).
+    The paper does not say how the columns are numbered. A numbering without owner
+    numbers its entries in the order they are written (a team of one) and gives the
+    robots selection slots in the order they first select, at most ``_ANYONE`` of them.
 
     A tag names one vertex with one row of angles (the row its beacon got when dropped);
     writing a tag again with other angles raises ``ValueError``. The other end of a
@@ -140,9 +152,8 @@ class Numbering:
     with a teammate's besides the ends where a new edge shows a disagreement.
     """
 
-    __slots__ = ("choice_mask", "choices", "drawn", "end_at", "end_index", "index", "linked",
-                 "mine", "other", "owner", "row_at", "rows", "selected", "selection_mask",
-                 "tag_mask", "tangled", "team")
+    __slots__ = ("drawn", "end_at", "end_index", "index", "letters", "linked", "other", "owner",
+                 "nobody", "row_at", "rows", "slots", "tag_mask", "tangled", "team")
 
     def __init__(self, owner: str | None = None, team: int = 1) -> None:
         #: letters of the robot whose team numbering this is (None: positions in order),
@@ -151,8 +162,8 @@ class Numbering:
         self.index = 0 if owner is None else parse_beacon_id(f"{owner}1")[0]
         if not 0 <= self.index < team:
             raise ValueError(f"robot {owner} is not one of a team of {team}")
-        #: the number of ends of the rows written here, and of selections made here
-        self.drawn = self.mine = 0
+        #: the number of ends of the rows written here
+        self.drawn = 0
         #: tag -> its row, position -> row, and the bits of all tags
         self.rows: dict[str, Row] = {}
         self.row_at: dict[int, Row] = {}
@@ -164,12 +175,11 @@ class Numbering:
         #: the bits of those ends, and of the ends seen with two other ends
         self.other: dict[int, End] = {}
         self.linked = self.tangled = 0
-        #: end position -> {robot letters: bit of "that robot selected this end"}, and the
-        #: bits of all its selections; selection position -> (end position, robot letters)
-        self.choices: dict[int, dict[str, int]] = {}
-        self.choice_mask: dict[int, int] = {}
-        self.selected: dict[int, tuple[int, str]] = {}
-        self.selection_mask = 0
+        #: selections: robot letters -> slot and slot -> letters; no robot's selections
+        #: (one bit set of end positions a slot)
+        self.letters = [] if owner is None else [robot_letters(r) for r in range(team)]
+        self.slots = {robot: r for r, robot in enumerate(self.letters)}
+        self.nobody = (0,) * (_ANYONE if owner is None else team)
 
     def row(self, tag: str, angles: tuple[float, ...]) -> Row:
         """The row of ``tag``, numbering it if new (in a team numbering only the owner's
@@ -223,38 +233,28 @@ class Numbering:
         self.tangled |= (1 << i) | (1 << self.end_index.get(other, i))
         return False
 
-    def choice(self, i: int, robot: str) -> int:
-        """The bit of "robot ``robot`` selected end ``i``", numbering it if new."""
-        bit = self.choices.get(i, {}).get(robot)
-        if bit is None:
-            if self.owner is not None and robot != self.owner:
-                raise ValueError(f"robot {robot} selects in the numbering of {self.owner}")
-            bit = self._chosen(self.mine * self.team + self.index, i, robot)
-            self.mine += 1
-        return bit
-
-    def _chosen(self, at: int, i: int, robot: str) -> int:
-        bit = self.choices.setdefault(i, {})[robot] = 1 << at
-        self.selected[at] = (i, robot)
-        self.choice_mask[i] = self.choice_mask.get(i, 0) | bit
-        self.selection_mask |= bit
-        return bit
+    def slot(self, robot: str) -> int:
+        """The slot of robot ``robot``'s selections: its index in a team; in a numbering
+        without owner, the order of the robots' first selections."""
+        r = self.slots.get(robot)
+        if r is None:
+            if self.owner is not None or len(self.letters) == len(self.nobody):
+                raise ValueError(f"robot {robot} has no slot in the numbering of {self.owner}")
+            r = self.slots[robot] = len(self.letters)
+            self.letters.append(robot)
+        return r
 
     def learn(self, m: IncidenceMatrix) -> IncidenceMatrix:
         """``m``, a matrix of a teammate's team numbering, written in this one: the same
-        bits, once the rows and selections new here are taken over (they have the same
-        positions) and the other ends of its completed ends reconciled (:meth:`_reconcile`).
-        Only what is new here is looked at."""
+        bits, once the rows new here are taken over (they have the same positions) and the
+        other ends of its completed ends reconciled (:meth:`_reconcile`). Only what is new
+        here is looked at; selections need nothing (their positions are arithmetic)."""
         there = m.numbering
         new = m._tags & ~self.tag_mask
         if new:
             row_at = there.row_at
             for at in _positions(new):
                 self._add(row_at[at])
-        new = m._selections & ~self.selection_mask
-        if new:
-            for at in _positions(new):
-                self._chosen(at, *there.selected[at])
         return IncidenceMatrix._of(self, m._tags, m._ends, m._completed, m._out,
                                    m._selections, self._reconcile(m), m._first, m._blocked)
 
@@ -262,9 +262,13 @@ class Numbering:
         """Record the other ends of ``m``'s completed ends new here (as ``m`` knows them);
         the ends whose other end in ``m`` is not the one recorded here (``m``'s
         ``_moved`` in this numbering). Compared are the ends tangled in either numbering
-        or moved in ``m``, and an end whose recorded other end a new edge contradicts;
-        the paper is silent on tags of one vertex, and edges whose two ends both have a
-        second tag, each known here untangled, are not compared."""
+        or moved in ``m``, and an end whose recorded other end a new edge contradicts.
+        The paper is silent on tags of one vertex. Not compared (a known gap): an edge
+        both of whose vertices were re-dropped, completed by two robots in crossing order
+        (``u1``-``v2`` by one, ``u2``-``v1`` by the other), where this numbering and
+        ``m``'s each hold one pairing untangled; the pairing recorded here is kept, a true
+        edge of the same two vertices under other tags. Closing it means comparing every
+        common completed end, the per-end work this comparison avoids."""
         there, done, moved_m = m.numbering, m._completed, m._moved
         marks = there.tangled & done
         for i in moved_m:
@@ -273,14 +277,7 @@ class Numbering:
         suspects = self.tangled & done & self.linked
         new = done & ~self.linked
         if new:
-            other, theirs, index, linked = self.other, there.other, self.end_index, self.linked
-            for i in _positions(new):
-                e = other[i] = moved_m.get(i) or theirs[i]
-                j = index[e]
-                if linked >> j & 1 and other[j] != self.end_at[i]:
-                    suspects |= 1 << j
-                    self.tangled |= (1 << i) | (1 << j)
-            self.linked |= new
+            suspects |= self._link_all(new, moved_m, there.other)
         if not suspects:
             return _UNMOVED
         moved = {}
@@ -289,6 +286,25 @@ class Numbering:
             if e != self.other[i]:
                 moved[i] = e
         return moved or _UNMOVED
+
+    def _link_all(self, new: int, moved: Mapping[int, End], theirs: Mapping[int, End]) -> int:
+        """Record the other ends of the completed ends ``new``, none linked here, as a
+        teammate knows them (``moved``, else ``theirs``); the bits of the ends linked here
+        whose recorded other end a new edge contradicts (both ends become tangled). Only
+        other ends that are not new can contradict."""
+        ends = _positions(new)
+        found = [moved.get(i) or theirs[i] for i in ends] if moved else [
+            theirs[i] for i in ends]
+        self.other.update(zip(ends, found))
+        partners = list(map(self.end_index.__getitem__, found))
+        suspects = 0
+        if not set(partners).issubset(ends):
+            for i, j in zip(ends, partners):
+                if self.linked >> j & 1 and self.other[j] != self.end_at[i]:
+                    suspects |= 1 << j
+                    self.tangled |= (1 << i) | (1 << j)
+        self.linked |= new
+        return suspects
 
 
 def _positions(bits: int) -> list[int]:
@@ -320,11 +336,12 @@ class IncidenceMatrix:
 
     # Bit sets (positions of ``numbering``): ``_tags`` the known rows, ``_ends`` the ends
     # of those rows, ``_completed`` and ``_out`` the completed and out ends, ``_selections``
-    # who selected which out end (never a completed one). ``_moved``: end position -> other
-    # end, where it is not the one the numbering recorded first. ``_first``: the first key
-    # of ``completed`` as a dict would order it, the end of a one-edge matrix that a merge
-    # looks at (see :func:`merge`). ``_tree``: the source and the parents of the latest
-    # breadth-first search over ``Gc`` (see :meth:`layers`), reused by :meth:`route`.
+    # for each selection slot of the numbering, the out ends that robot selected (never a
+    # completed one). ``_moved``: end position -> other end, where it is not the one the
+    # numbering recorded first. ``_first``: the first key of ``completed`` as a dict would
+    # order it, the end of a one-edge matrix that a merge looks at (see :func:`merge`).
+    # ``_tree``: the source and the parents of the latest breadth-first search over ``Gc``
+    # (see :meth:`layers`), reused by :meth:`route`.
     # ``_blocked``: the blocked ends (module docstring), 0 without closed vertices.
     __slots__ = ("_blocked", "_completed", "_ends", "_first", "_moved", "_out", "_selections",
                  "_tags", "_tree", "numbering")
@@ -349,15 +366,15 @@ class IncidenceMatrix:
             done |= 1 << i
             if not n.link(i, f):
                 moved[i] = f
-        marked = selections = 0
+        marked, selections = 0, list(n.nobody)
         for e, who in out.items():
             i = n.end(e)
             if not done >> i & 1:
                 marked |= 1 << i
                 for robot in who:
-                    selections |= n.choice(i, robot)
+                    selections[n.slot(robot)] |= 1 << i
         self.numbering, self._tags, self._ends, self._completed = n, tags, ends, done
-        self._out, self._selections = marked, selections
+        self._out, self._selections = marked, tuple(selections)
         self._moved, self._first = moved or _UNMOVED, next(iter(completed), None)
         self._blocked = 0
         for e in blocked:
@@ -366,7 +383,7 @@ class IncidenceMatrix:
 
     @classmethod
     def _of(cls, numbering: Numbering, tags: int, ends: int, completed: int, out: int,
-                selections: int, moved: Mapping[int, End], first: End | None,
+                selections: tuple[int, ...], moved: Mapping[int, End], first: End | None,
             blocked: int = 0) -> IncidenceMatrix:
         """A matrix from its bit sets (see the comment on ``__slots__``)."""
         m = object.__new__(cls)
@@ -382,7 +399,7 @@ class IncidenceMatrix:
         """``I0(vj)`` of eq. (14): one row, every edge of the vertex unexplored."""
         n = _writable(numbering)
         row = n.row(tag, tuple(angles))
-        return cls._of(n, row.bit, row.mask, 0, 0, 0, _UNMOVED, None)
+        return cls._of(n, row.bit, row.mask, 0, 0, n.nobody, _UNMOVED, None)
 
     @classmethod
     def edge(
@@ -400,7 +417,7 @@ class IncidenceMatrix:
         if not n.link(j, end_i):
             moved[j] = end_i
         return cls._of(n, row_i.bit | row_j.bit, row_i.mask | row_j.mask,
-                       (1 << i) | (1 << j), 0, 0, moved or _UNMOVED, end_i)
+                       (1 << i) | (1 << j), 0, n.nobody, moved or _UNMOVED, end_i)
 
     # -- the matrix as dictionaries -----------------------------------------------------
 
@@ -466,9 +483,8 @@ class IncidenceMatrix:
 
     def _selectors(self, i: int) -> frozenset[str]:
         """Letters of the robots known to have selected the out end at position ``i``."""
-        chosen = self._selections
-        return frozenset([r for r, bit in self.numbering.choices.get(i, {}).items()
-                          if chosen & bit])
+        letters = self.numbering.letters
+        return frozenset([letters[r] for r, ends in enumerate(self._selections) if ends >> i & 1])
 
     def is_complete(self, source: str | None = None, root: str | None = None) -> bool:
         """Theorem 1: exploration is complete iff ``Eu`` and ``Eo`` are empty, i.e. every
@@ -649,11 +665,12 @@ class IncidenceMatrix:
         i = n.end(end)
         if self._completed >> i & 1:
             return self
-        choice = n.choice(i, robot)
-        if self._selections & choice:
+        r, bit, selections = n.slot(robot), 1 << i, self._selections
+        if selections[r] & bit:
             return self
-        m = self._of(n, self._tags, self._ends, self._completed, self._out | 1 << i,
-                     self._selections | choice, self._moved, self._first, self._blocked)
+        selections = (*selections[:r], selections[r] | bit, *selections[r + 1:])
+        m = self._of(n, self._tags, self._ends, self._completed, self._out | bit,
+                     selections, self._moved, self._first, self._blocked)
         m._tree = self._tree  # the same Gc
         return m
 
@@ -679,7 +696,7 @@ class IncidenceMatrix:
 _NONE = Numbering()
 
 #: ``I0(Rk)`` of eq. (14): a robot at the start knows nothing.
-EMPTY = IncidenceMatrix._of(_NONE, 0, 0, 0, 0, 0, _UNMOVED, None)
+EMPTY = IncidenceMatrix._of(_NONE, 0, 0, 0, 0, _NONE.nobody, _UNMOVED, None)
 
 
 def _writable(numbering: Numbering | None) -> Numbering:
@@ -727,20 +744,16 @@ def merge(a: IncidenceMatrix, b: IncidenceMatrix) -> IncidenceMatrix:
 def _union(a: IncidenceMatrix, b: IncidenceMatrix) -> IncidenceMatrix:
     """Algorithm 1's union of two matrices of one numbering (``b``'s other ends win)."""
     done = a._completed | b._completed
-    selections = a._selections | b._selections
-    settled = (a._out & b._completed) | (b._out & a._completed)
-    if settled:  # out on one side, completed on the other: the selections go
-        choice_mask = a.numbering.choice_mask
-        while settled:
-            low = settled & -settled
-            selections &= ~choice_mask.get(low.bit_length() - 1, 0)
-            settled ^= low
+    out = (a._out | b._out) & ~done  # out on one side, completed on the other: not out
+    selections = a._selections
+    if selections is not b._selections:
+        selections = tuple([(x | y) & out for x, y in zip(selections, b._selections)])
     moved = _UNMOVED
     if a._moved or b._moved:
         moved = {i: e for i, e in a._moved.items() if not b._completed >> i & 1}
         moved.update(b._moved)
     return IncidenceMatrix._of(
-        a.numbering, a._tags | b._tags, a._ends | b._ends, done, (a._out | b._out) & ~done,
+        a.numbering, a._tags | b._tags, a._ends | b._ends, done, out,
         selections, moved, a._first if a._completed else b._first, a._blocked | b._blocked)
 
 
@@ -750,11 +763,10 @@ def _contains(a: IncidenceMatrix, b: IncidenceMatrix) -> bool:
     if b._tags & ~a._tags or b._completed & ~a._completed or (
             b._blocked and b._blocked & ~a._blocked):
         return False
-    missing = b._selections & ~a._selections
-    if missing:  # selections of ends a knows as completed do not count
-        choice_mask, settled = a.numbering.choice_mask, b._out & a._completed
-        while settled:
-            low = settled & -settled
-            missing &= ~choice_mask.get(low.bit_length() - 1, 0)
-            settled ^= low
-    return not missing
+    if b._selections is a._selections:
+        return True
+    done = a._completed  # selections of ends a knows as completed do not count
+    for x, y in zip(b._selections, a._selections):
+        if x & ~(y | done):
+            return False
+    return True
