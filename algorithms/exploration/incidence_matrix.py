@@ -20,15 +20,24 @@ one; a completed column replaces a one-entry column). Matrices are never modifie
 and beacon share one object after a visit (Algorithm 4's ``In(vj) = In(Rk)``).
 :meth:`IncidenceMatrix.to_array` gives the dense matrix of the paper.
 
-Bit sets. The matrices merged during one exploration share a :class:`Numbering`, which
-gives every tag, every end and every (end, selecting robot) pair a bit position, in the
-order the team first wrote them. A matrix itself is a handful of integers used as bit sets
-(its known rows, their ends, the completed ends, the out ends, the selections), so
-Algorithm 1's union is a few ``|`` and the containment test a few ``&``, however large the
-matrix. A numbering is only a table of names, and only grows: what a matrix knows is what
-its bits say. ``rows``, ``completed`` and ``out`` are built from the bits when asked for,
-in numbering order (the order in which the team first wrote each entry). Matrices of
-different numberings (built directly, e.g. by a test) are merged after renumbering one.
+Bit sets. Each robot writes its matrices in a :class:`Numbering` of its own, which
+gives every tag and every end a bit position. A matrix itself is a handful of integers
+used as bit sets over those positions (its known rows, their ends, the completed ends, the
+out ends, the blocked ends) and, for the selections, one bit set of end positions for each
+robot of the team, so Algorithm 1's union (equations (2) and (3)) is a few ``|`` and the
+containment test a few ``&``, however large the matrix. A position is a function of who
+wrote the entry: robot ``r`` of a team of ``K`` writes its ``c``-th entry at ``c * K + r``,
+so the numberings of one team agree wherever they name the same entry and a matrix read
+from a teammate's beacon keeps its bits. A vertex's row (``I0(vj)`` of eq. (14), with the
+positions of its ends) is one immutable :class:`Row` value, made by the robot that drops
+the beacon and held by reference in every numbering that knows the vertex; eq. (5)'s
+negation by robot ``r`` sets the end's bit in ``r``'s selection set, whose place is the
+same in every numbering. Reading a teammate's matrix (:meth:`Numbering.learn`) copies
+into the robot's numbering only the rows and the other ends of completed ends new to it;
+nothing a numbering holds that can change is reachable from another robot. ``rows``,
+``completed`` and ``out`` are built from the bits when asked for, in numbering order.
+Matrices of numberings of no team (built directly, e.g. by a test) are merged after
+renumbering one.
 
 Blocked ends (ours: a body that cannot be passed). An end is *blocked* when
 the vertex at its far end is closed: a robot stopped for good in that vertex's area,
@@ -64,13 +73,18 @@ run without closed vertices, and every query then takes the path without blocked
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 from types import MappingProxyType
 
 import numpy as np
 
+from algorithms.exploration.beacon_ids import parse_beacon_id, robot_letters
+
 End = tuple[str, float]
 
 _NOBODY: frozenset[str] = frozenset()
+#: The most robots whose selections a numbering without owner records.
+_ANYONE = 26
 #: ``IncidenceMatrix._moved`` when every completed end has its first-written other end.
 _UNMOVED: Mapping[int, End] = MappingProxyType({})
 
@@ -78,95 +92,229 @@ _UNMOVED: Mapping[int, End] = MappingProxyType({})
 UNKNOWN, UNEXPLORED, OUT, COMPLETED = -1, 0, 1, 2
 
 
+@dataclass(frozen=True, slots=True)
+class Row:
+    """One vertex's row ``I0(vj)`` of eq. (14) as numbered: its tag, the tag's position
+    ``at`` and bit, the incidence angles as written, and for each edge at the vertex
+    ``(angle, end position, end bit)`` in the same order (``ends``), with the ends' names
+    and positions and the bits of all of them (``mask``). Written once, by whoever first
+    writes the tag (in a team, the robot that drops the beacon); every numbering that
+    learns the vertex holds this same value."""
+
+    tag: str
+    at: int
+    bit: int
+    angles: tuple[float, ...]
+    ends: tuple[tuple[float, int, int], ...]
+    names: tuple[End, ...]
+    positions: tuple[int, ...]
+    mask: int
+
+    @classmethod
+    def numbered(cls, tag: str, at: int, angles: tuple[float, ...], first: int,
+                 step: int) -> Row:
+        """The row of ``tag`` at position ``at`` whose ``k``-th end has position
+        ``first + k * step``."""
+        positions = tuple(range(first, first + len(angles) * step, step))
+        ends = tuple((a, i, 1 << i) for a, i in zip(angles, positions))
+        mask = 0
+        for _, _, bit in ends:
+            mask |= bit
+        return cls(tag, at, 1 << at, angles, ends, tuple((tag, a) for a in angles),
+                   positions, mask)
+
+
 class Numbering:
-    """Bit positions of the tags, ends and selections written by the matrices of one
-    exploration (see the module docstring). Entries are added, never changed or removed.
+    """Bit positions of the tags and ends written by one robot's matrices, or by matrices
+    built directly, and the slots of the robots' selections (see the module docstring).
+    Entries are added, never changed or removed.
+
+    A *team* numbering (``owner``: the letters of the robot whose numbering it is, one of
+    ``team`` robots) gives every entry a position that is a function of who wrote it, so
+    that the numberings of one team agree wherever they name the same entry. Robot ``r``
+    (0-based, :func:`~algorithms.exploration.beacon_ids.parse_beacon_id`) writes at the
+    positions ``c * team + r``: its tag of sequence ``s`` at ``c = s - 1`` and the ends of
+    its rows in the order it drops them (the ``k``-th end of a row at its ``base + k``,
+    ``base`` being the number of ends of the robot's earlier rows), so a vertex may have
+    any number of edges. Its selections are bit ``i`` of the ``r``-th of a matrix's
+    selection sets, ``i`` being the selected end. The dropping robot makes the vertex's
+    :class:`Row` record; a teammate learns it from the matrices it merges (:meth:`learn`).
+    The paper does not say how the columns are numbered. A numbering without owner
+    numbers its entries in the order they are written (a team of one) and gives the
+    robots selection slots in the order they first select, at most ``_ANYONE`` of them.
 
     A tag names one vertex with one row of angles (the row its beacon got when dropped);
     writing a tag again with other angles raises ``ValueError``. The other end of a
-    completed end is recorded as first written; a matrix that learned another one (a
-    re-dropped beacon gives a vertex a second tag) keeps it in ``IncidenceMatrix._moved``.
+    completed end is recorded as first written here (``other``, the recorded ends being
+    ``linked``); a matrix that knows another one (a re-dropped beacon gives a vertex a
+    second tag) keeps it in ``IncidenceMatrix._moved``. ``tangled`` holds the ends for
+    which two other ends were seen, the only ends whose other ends :meth:`learn` compares
+    with a teammate's besides the ends where a new edge shows a disagreement.
     """
 
-    __slots__ = ("choice_mask", "choices", "end_index", "ends", "other", "row_ends", "row_mask",
-                 "rows", "selections", "tag_bit", "tags")
+    __slots__ = ("drawn", "end_at", "end_index", "index", "letters", "linked", "other", "owner",
+                 "nobody", "row_at", "rows", "slots", "tag_mask", "tangled", "team")
 
-    def __init__(self) -> None:
-        #: tags by position, and each tag's bit
-        self.tags: list[str] = []
-        self.tag_bit: dict[str, int] = {}
-        #: tag -> incidence angles of its vertex (its ``I0`` row)
-        self.rows: dict[str, tuple[float, ...]] = {}
-        #: tag -> ``(angle, end position, end bit)`` of each edge at the vertex, by angle
-        self.row_ends: dict[str, tuple[tuple[float, int, int], ...]] = {}
-        #: tag -> the bits of all its ends
-        self.row_mask: dict[str, int] = {}
-        #: ends by position, and each end's position
-        self.ends: list[End] = []
+    def __init__(self, owner: str | None = None, team: int = 1) -> None:
+        #: letters of the robot whose team numbering this is (None: positions in order),
+        #: its 0-based index, and the team size
+        self.owner, self.team = owner, team
+        self.index = 0 if owner is None else parse_beacon_id(f"{owner}1")[0]
+        if not 0 <= self.index < team:
+            raise ValueError(f"robot {owner} is not one of a team of {team}")
+        #: the number of ends of the rows written here
+        self.drawn = 0
+        #: tag -> its row, position -> row, and the bits of all tags
+        self.rows: dict[str, Row] = {}
+        self.row_at: dict[int, Row] = {}
+        self.tag_mask = 0
+        #: end -> position, and position -> end
         self.end_index: dict[End, int] = {}
-        #: end position -> the other end of its completed edge, as first written
-        self.other: list[End | None] = []
-        #: end position -> {robot letters: bit of "that robot selected this end"}, and the
-        #: bits of all its selections
-        self.choices: list[dict[str, int]] = []
-        self.choice_mask: list[int] = []
-        #: number of selection bits given
-        self.selections = 0
+        self.end_at: dict[int, End] = {}
+        #: end position -> the other end of its completed edge, as first written here;
+        #: the bits of those ends, and of the ends seen with two other ends
+        self.other: dict[int, End] = {}
+        self.linked = self.tangled = 0
+        #: selections: robot letters -> slot and slot -> letters; no robot's selections
+        #: (one bit set of end positions a slot)
+        self.letters = [] if owner is None else [robot_letters(r) for r in range(team)]
+        self.slots = {robot: r for r, robot in enumerate(self.letters)}
+        self.nobody = (0,) * (_ANYONE if owner is None else team)
 
-    def row(self, tag: str, angles: tuple[float, ...]) -> int:
-        """The bit of ``tag``, numbering it and the ends of its row if new."""
-        bit = self.tag_bit.get(tag)
-        if bit is not None:
-            if self.rows[tag] != angles:
+    def row(self, tag: str, angles: tuple[float, ...]) -> Row:
+        """The row of ``tag``, numbering it if new (in a team numbering only the owner's
+        tags are new: a teammate's row is learned, else ``KeyError``)."""
+        row = self.rows.get(tag)
+        if row is not None:
+            if row.angles != angles:
                 raise ValueError(f"vertex {tag} written with two rows, "
-                                 f"{self.rows[tag]} and {angles}")
-            return bit
-        bit = self.tag_bit[tag] = 1 << len(self.tags)
-        self.tags.append(tag)
-        self.rows[tag] = angles
-        ends, mask = [], 0
-        for a in angles:
-            i = self.end((tag, a))
-            ends.append((a, i, 1 << i))
-            mask |= 1 << i
-        self.row_ends[tag] = tuple(ends)
-        self.row_mask[tag] = mask
-        return bit
+                                 f"{row.angles} and {angles}")
+            return row
+        if self.owner is None:
+            at = len(self.rows)
+        else:
+            r, s = parse_beacon_id(tag)
+            if r != self.index:
+                raise KeyError(f"vertex {tag} of a teammate is not numbered here")
+            at = (s - 1) * self.team + r
+        row = Row.numbered(tag, at, angles, self._next(len(angles)), self.team)
+        self._add(row)
+        return row
+
+    def _next(self, count: int) -> int:
+        """The position of the first of ``count`` new ends written here."""
+        first = self.drawn * self.team + self.index
+        self.drawn += count
+        return first
+
+    def _add(self, row: Row) -> None:
+        self.rows[row.tag] = self.row_at[row.at] = row
+        self.tag_mask |= row.bit
+        self.end_index.update(zip(row.names, row.positions))
+        self.end_at.update(zip(row.positions, row.names))
 
     def end(self, end: End) -> int:
-        """The position of ``end``, numbering it if new."""
+        """The position of ``end``, numbering it if new (in a team numbering, an end of a
+        row not written here raises ``KeyError``)."""
         i = self.end_index.get(end)
         if i is None:
-            i = self.end_index[end] = len(self.ends)
-            self.ends.append(end)
-            self.other.append(None)
-            self.choices.append({})
-            self.choice_mask.append(0)
+            if self.owner is not None:
+                raise KeyError(f"{end} is no end of a vertex numbered here")
+            i = self.end_index[end] = self._next(1)
+            self.end_at[i] = end
         return i
 
     def link(self, i: int, other: End) -> bool:
         """Record ``other`` as the other end of end ``i`` unless one is recorded; whether
-        the recorded one is ``other``."""
-        first = self.other[i]
-        if first is None:
-            self.other[i] = other
+        the recorded one is ``other`` (if not, both are tangled)."""
+        if self.other.setdefault(i, other) == other:
+            self.linked |= 1 << i
             return True
-        return first == other
+        self.tangled |= (1 << i) | (1 << self.end_index.get(other, i))
+        return False
 
-    def choice(self, i: int, robot: str) -> int:
-        """The bit of "robot ``robot`` selected end ``i``", numbering it if new."""
-        bits = self.choices[i]
-        bit = bits.get(robot)
-        if bit is None:
-            bit = bits[robot] = 1 << self.selections
-            self.selections += 1
-            self.choice_mask[i] |= bit
-        return bit
+    def slot(self, robot: str) -> int:
+        """The slot of robot ``robot``'s selections: its index in a team; in a numbering
+        without owner, the order of the robots' first selections."""
+        r = self.slots.get(robot)
+        if r is None:
+            if self.owner is not None or len(self.letters) == len(self.nobody):
+                raise ValueError(f"robot {robot} has no slot in the numbering of {self.owner}")
+            r = self.slots[robot] = len(self.letters)
+            self.letters.append(robot)
+        return r
+
+    def learn(self, m: IncidenceMatrix) -> IncidenceMatrix:
+        """``m``, a matrix of a teammate's team numbering, written in this one: the same
+        bits, once the rows new here are taken over (they have the same positions) and the
+        other ends of its completed ends reconciled (:meth:`_reconcile`). Only what is new
+        here is looked at; selections need nothing (their positions are arithmetic)."""
+        there = m.numbering
+        new = m._tags & ~self.tag_mask
+        if new:
+            row_at = there.row_at
+            for at in _positions(new):
+                self._add(row_at[at])
+        return IncidenceMatrix._of(self, m._tags, m._ends, m._completed, m._out,
+                                   m._selections, self._reconcile(m), m._first, m._blocked)
+
+    def _reconcile(self, m: IncidenceMatrix) -> Mapping[int, End]:
+        """Record the other ends of ``m``'s completed ends new here (as ``m`` knows them);
+        the ends whose other end in ``m`` is not the one recorded here (``m``'s
+        ``_moved`` in this numbering). Compared are the ends tangled in either numbering
+        or moved in ``m``, and an end whose recorded other end a new edge contradicts.
+        The paper is silent on tags of one vertex. Not compared (a known gap): an edge
+        both of whose vertices were re-dropped, completed by two robots in crossing order
+        (``u1``-``v2`` by one, ``u2``-``v1`` by the other), where this numbering and
+        ``m``'s each hold one pairing untangled; the pairing recorded here is kept, a true
+        edge of the same two vertices under other tags. Closing it means comparing every
+        common completed end, the per-end work this comparison avoids."""
+        there, done, moved_m = m.numbering, m._completed, m._moved
+        marks = there.tangled & done
+        for i in moved_m:
+            marks |= 1 << i
+        self.tangled |= marks
+        suspects = self.tangled & done & self.linked
+        new = done & ~self.linked
+        if new:
+            suspects |= self._link_all(new, moved_m, there.other)
+        if not suspects:
+            return _UNMOVED
+        moved = {}
+        for i in _positions(suspects):
+            e = moved_m.get(i) or there.other[i]
+            if e != self.other[i]:
+                moved[i] = e
+        return moved or _UNMOVED
+
+    def _link_all(self, new: int, moved: Mapping[int, End], theirs: Mapping[int, End]) -> int:
+        """Record the other ends of the completed ends ``new``, none linked here, as a
+        teammate knows them (``moved``, else ``theirs``); the bits of the ends linked here
+        whose recorded other end a new edge contradicts (both ends become tangled). Only
+        other ends that are not new can contradict."""
+        ends = _positions(new)
+        found = [moved.get(i) or theirs[i] for i in ends] if moved else [
+            theirs[i] for i in ends]
+        self.other.update(zip(ends, found))
+        partners = list(map(self.end_index.__getitem__, found))
+        suspects = 0
+        if not set(partners).issubset(ends):
+            for i, j in zip(ends, partners):
+                if self.linked >> j & 1 and self.other[j] != self.end_at[i]:
+                    suspects |= 1 << j
+                    self.tangled |= (1 << i) | (1 << j)
+        self.linked |= new
+        return suspects
 
 
 def _positions(bits: int) -> list[int]:
     """Positions of the set bits of ``bits``, lowest first."""
-    return [i for i, digit in enumerate(bin(bits)[:1:-1]) if digit == "1"]
+    found = []
+    while bits:
+        low = bits & -bits
+        found.append(low.bit_length() - 1)
+        bits ^= low
+    return found
 
 
 class IncidenceMatrix:
@@ -188,11 +336,12 @@ class IncidenceMatrix:
 
     # Bit sets (positions of ``numbering``): ``_tags`` the known rows, ``_ends`` the ends
     # of those rows, ``_completed`` and ``_out`` the completed and out ends, ``_selections``
-    # who selected which out end (never a completed one). ``_moved``: end position -> other
-    # end, where it is not the one the numbering recorded first. ``_first``: the first key
-    # of ``completed`` as a dict would order it, the end of a one-edge matrix that a merge
-    # looks at (see :func:`merge`). ``_tree``: the source and the parents of the latest
-    # breadth-first search over ``Gc`` (see :meth:`layers`), reused by :meth:`route`.
+    # for each selection slot of the numbering, the out ends that robot selected (never a
+    # completed one). ``_moved``: end position -> other end, where it is not the one the
+    # numbering recorded first. ``_first``: the first key of ``completed`` as a dict would
+    # order it, the end of a one-edge matrix that a merge looks at (see :func:`merge`).
+    # ``_tree``: the source and the parents of the latest breadth-first search over ``Gc``
+    # (see :meth:`layers`), reused by :meth:`route`.
     # ``_blocked``: the blocked ends (module docstring), 0 without closed vertices.
     __slots__ = ("_blocked", "_completed", "_ends", "_first", "_moved", "_out", "_selections",
                  "_tags", "_tree", "numbering")
@@ -208,23 +357,24 @@ class IncidenceMatrix:
         n = _writable(numbering)
         tags = ends = 0
         for tag, angles in rows.items():
-            tags |= n.row(tag, tuple(angles))
-            ends |= n.row_mask[tag]
+            row = n.row(tag, tuple(angles))
+            tags |= row.bit
+            ends |= row.mask
         done, moved = 0, {}
         for e, f in completed.items():
             i = n.end(e)
             done |= 1 << i
             if not n.link(i, f):
                 moved[i] = f
-        marked = selections = 0
+        marked, selections = 0, list(n.nobody)
         for e, who in out.items():
             i = n.end(e)
             if not done >> i & 1:
                 marked |= 1 << i
                 for robot in who:
-                    selections |= n.choice(i, robot)
+                    selections[n.slot(robot)] |= 1 << i
         self.numbering, self._tags, self._ends, self._completed = n, tags, ends, done
-        self._out, self._selections = marked, selections
+        self._out, self._selections = marked, tuple(selections)
         self._moved, self._first = moved or _UNMOVED, next(iter(completed), None)
         self._blocked = 0
         for e in blocked:
@@ -233,7 +383,7 @@ class IncidenceMatrix:
 
     @classmethod
     def _of(cls, numbering: Numbering, tags: int, ends: int, completed: int, out: int,
-                selections: int, moved: Mapping[int, End], first: End | None,
+                selections: tuple[int, ...], moved: Mapping[int, End], first: End | None,
             blocked: int = 0) -> IncidenceMatrix:
         """A matrix from its bit sets (see the comment on ``__slots__``)."""
         m = object.__new__(cls)
@@ -248,7 +398,8 @@ class IncidenceMatrix:
     ) -> IncidenceMatrix:
         """``I0(vj)`` of eq. (14): one row, every edge of the vertex unexplored."""
         n = _writable(numbering)
-        return cls._of(n, n.row(tag, tuple(angles)), n.row_mask[tag], 0, 0, 0, _UNMOVED, None)
+        row = n.row(tag, tuple(angles))
+        return cls._of(n, row.bit, row.mask, 0, 0, n.nobody, _UNMOVED, None)
 
     @classmethod
     def edge(
@@ -258,15 +409,15 @@ class IncidenceMatrix:
         """``I'`` of Algorithm 3: the column of the completed edge ``e_ij`` (with the rows of
         its two vertices, whose other edges are unexplored unless known otherwise)."""
         n = _writable(numbering)
-        tags = n.row(end_i[0], tuple(angles_i)) | n.row(end_j[0], tuple(angles_j))
+        row_i, row_j = n.row(end_i[0], tuple(angles_i)), n.row(end_j[0], tuple(angles_j))
         i, j = n.end(end_i), n.end(end_j)
         moved = {}
         if not n.link(i, end_j):
             moved[i] = end_j
         if not n.link(j, end_i):
             moved[j] = end_i
-        return cls._of(n, tags, n.row_mask[end_i[0]] | n.row_mask[end_j[0]],
-                       (1 << i) | (1 << j), 0, 0, moved or _UNMOVED, end_i)
+        return cls._of(n, row_i.bit | row_j.bit, row_i.mask | row_j.mask,
+                       (1 << i) | (1 << j), 0, n.nobody, moved or _UNMOVED, end_i)
 
     # -- the matrix as dictionaries -----------------------------------------------------
 
@@ -274,18 +425,18 @@ class IncidenceMatrix:
     def rows(self) -> dict[str, tuple[float, ...]]:
         """Tag -> incidence angles, for every known vertex (``Vc``)."""
         n, known = self.numbering, self._tags
-        return {t: n.rows[t] for t in n.tags if known & n.tag_bit[t]}
+        return {t: row.angles for t, row in n.rows.items() if known & row.bit}
 
     @property
     def completed(self) -> dict[End, End]:
         """End -> other end, for both ends of every completed edge (``Ec``)."""
-        ends, other = self.numbering.ends, self._others()
+        ends, other = self.numbering.end_at, self._others()
         return {ends[i]: other[i] for i in _positions(self._completed)}
 
     @property
     def out(self) -> dict[End, frozenset[str]]:
         """Out end -> letters of the robots known to have selected it (``Eo``)."""
-        return {self.numbering.ends[i]: self._selectors(i) for i in _positions(self._out)}
+        return {self.numbering.end_at[i]: self._selectors(i) for i in _positions(self._out)}
 
     @property
     def any_blocked(self) -> bool:
@@ -295,7 +446,7 @@ class IncidenceMatrix:
     @property
     def blocked(self) -> list[End]:
         """The blocked ends (module docstring), in numbering order."""
-        return [self.numbering.ends[i] for i in _positions(self._blocked)]
+        return [self.numbering.end_at[i] for i in _positions(self._blocked)]
 
     # -- queries --------------------------------------------------------------------
 
@@ -313,13 +464,15 @@ class IncidenceMatrix:
                 return COMPLETED
             if self._out >> i & 1:
                 return OUT
-        return UNEXPLORED if self._tags & n.tag_bit.get(end[0], 0) else UNKNOWN
+        row = n.rows.get(end[0])
+        return UNEXPLORED if row is not None and self._tags & row.bit else UNKNOWN
 
     def angles(self, tag: str) -> tuple[float, ...]:
         """The row of a known vertex: its incidence angles (``KeyError`` if unknown)."""
-        if not self._tags & self.numbering.tag_bit.get(tag, 0):
+        row = self.numbering.rows.get(tag)
+        if row is None or not self._tags & row.bit:
             raise KeyError(tag)
-        return self.numbering.rows[tag]
+        return row.angles
 
     def selectors(self, end: End) -> frozenset[str]:
         """Letters of the robots known to have selected ``end`` if it is out, else none."""
@@ -330,8 +483,8 @@ class IncidenceMatrix:
 
     def _selectors(self, i: int) -> frozenset[str]:
         """Letters of the robots known to have selected the out end at position ``i``."""
-        chosen = self._selections
-        return frozenset([r for r, bit in self.numbering.choices[i].items() if chosen & bit])
+        letters = self.numbering.letters
+        return frozenset([letters[r] for r, ends in enumerate(self._selections) if ends >> i & 1])
 
     def is_complete(self, source: str | None = None, root: str | None = None) -> bool:
         """Theorem 1: exploration is complete iff ``Eu`` and ``Eo`` are empty, i.e. every
@@ -353,9 +506,9 @@ class IncidenceMatrix:
         return self._finished(self.reach(source))
 
     def _finished(self, reach: set[str]) -> bool:
-        row_mask, ends = self.numbering.row_mask, 0
+        rows, ends = self.numbering.rows, 0
         for t in reach:
-            ends |= row_mask[t]
+            ends |= rows[t].mask
         return not ends & ~(self._completed | self._blocked)
 
     def reach(self, source: str) -> set[str]:
@@ -365,25 +518,26 @@ class IncidenceMatrix:
 
     def unexplored(self) -> list[End]:
         """``Eu``: unexplored ends (blocked ones left out), in row order then angle order."""
-        row_ends, taken = self.numbering.row_ends, self._completed | self._out
+        rows, known, taken = self.numbering.rows, self._tags, self._completed | self._out
         if self._blocked:
             taken |= self._blocked
-        return [(tag, a) for tag in self.rows for a, _, bit in row_ends[tag] if not taken & bit]
+        return [(tag, a) for tag, row in rows.items() if known & row.bit
+                for a, _, bit in row.ends if not taken & bit]
 
     def unexplored_at(self, tag: str) -> list[float]:
         """Angles of the unexplored edges at vertex ``tag`` (``Em(vj)`` for a beacon;
         blocked ones left out)."""
-        n = self.numbering
-        if not self._tags & n.tag_bit.get(tag, 0):
+        row = self.numbering.rows.get(tag)
+        if row is None or not self._tags & row.bit:
             return []
         taken = self._completed | self._out
         if self._blocked:
             taken |= self._blocked
-        return [a for a, _, bit in n.row_ends[tag] if not taken & bit]
+        return [a for a, _, bit in row.ends if not taken & bit]
 
     def completed_edges(self) -> list[tuple[End, End]]:
         """``Ec``: each completed edge once, as its two ends."""
-        ends, other = self.numbering.ends, self._others()
+        ends, other = self.numbering.end_at, self._others()
         return [(ends[i], other[i]) for i in _positions(self._completed) if ends[i] < other[i]]
 
     def order(self) -> list[tuple[End, ...]]:
@@ -410,22 +564,18 @@ class IncidenceMatrix:
 
     # -- the completed graph Gc -----------------------------------------------------
 
-    def _others(self) -> list[End | None]:
+    def _others(self) -> Mapping[int, End]:
         """End position -> the other end of its edge, as this matrix knows it (read it
         for completed ends only)."""
         other = self.numbering.other
-        if self._moved:
-            other = other.copy()
-            for i, e in self._moved.items():
-                other[i] = e
-        return other
+        return {**other, **self._moved} if self._moved else other
 
     def layers(self, source: str, parents: dict[str, End | None] | None = None):
         """Breadth-first layers of ``Gc`` from ``source``: lists of tags by hop distance,
         each vertex's completed edges taken by angle, never leaving by a blocked end.
         ``parents``, if given, receives for each tag reached the end it was reached by
         (None for ``source``)."""
-        row_ends, done, other = self.numbering.row_ends, self._completed, self._others()
+        rows, done, other = self.numbering.rows, self._completed, self._others()
         if self._blocked:
             done &= ~self._blocked
         seen = {} if parents is None else parents
@@ -436,7 +586,7 @@ class IncidenceMatrix:
             yield layer
             following = []
             for t in layer:
-                for a, i, bit in row_ends[t]:
+                for a, i, bit in rows[t].ends:
                     if done & bit:
                         u = other[i][0]
                         if u not in seen:
@@ -463,12 +613,11 @@ class IncidenceMatrix:
         n, done, out = self.numbering, self._completed, self._out
         if self._blocked:
             done |= self._blocked
-        row_mask, row_ends = n.row_mask, n.row_ends
-        nearest_out = 0
+        rows, nearest_out = n.rows, 0
         for layer in self.layers(source):
             ends = 0
             for t in layer:
-                ends |= row_mask[t]
+                ends |= rows[t].mask
             open_ends = ends & ~done
             if open_ends & ~out:
                 chosen = open_ends & ~out
@@ -479,7 +628,7 @@ class IncidenceMatrix:
             if not nearest_out:
                 return []
             chosen, layer = nearest_out, at
-        return [(t, a) for t in layer for a, _, bit in row_ends[t] if chosen & bit]
+        return [(t, a) for t in layer for a, _, bit in rows[t].ends if chosen & bit]
 
     def route(self, source: str, target: str) -> list[End]:
         """A shortest path from ``source`` to ``target`` over ``Gc`` (Lemma 1 / Remark 4:
@@ -516,11 +665,12 @@ class IncidenceMatrix:
         i = n.end(end)
         if self._completed >> i & 1:
             return self
-        choice = n.choice(i, robot)
-        if self._selections & choice:
+        r, bit, selections = n.slot(robot), 1 << i, self._selections
+        if selections[r] & bit:
             return self
-        m = self._of(n, self._tags, self._ends, self._completed, self._out | 1 << i,
-                     self._selections | choice, self._moved, self._first, self._blocked)
+        selections = (*selections[:r], selections[r] | bit, *selections[r + 1:])
+        m = self._of(n, self._tags, self._ends, self._completed, self._out | bit,
+                     selections, self._moved, self._first, self._blocked)
         m._tree = self._tree  # the same Gc
         return m
 
@@ -546,7 +696,7 @@ class IncidenceMatrix:
 _NONE = Numbering()
 
 #: ``I0(Rk)`` of eq. (14): a robot at the start knows nothing.
-EMPTY = IncidenceMatrix._of(_NONE, 0, 0, 0, 0, 0, _UNMOVED, None)
+EMPTY = IncidenceMatrix._of(_NONE, 0, 0, 0, 0, _NONE.nobody, _UNMOVED, None)
 
 
 def _writable(numbering: Numbering | None) -> Numbering:
@@ -573,7 +723,10 @@ def merge(a: IncidenceMatrix, b: IncidenceMatrix) -> IncidenceMatrix:
     if a is EMPTY:
         return b
     if b.numbering is not a.numbering:
-        b = b._renumbered(a.numbering)
+        if a.numbering.owner is None or b.numbering.owner is None:
+            b = b._renumbered(a.numbering)
+        else:
+            b = a.numbering.learn(b)
     count_a, count_b = a._completed.bit_count(), b._completed.bit_count()
     if count_a < count_b:
         a, b, count_b = b, a, count_a
@@ -591,20 +744,16 @@ def merge(a: IncidenceMatrix, b: IncidenceMatrix) -> IncidenceMatrix:
 def _union(a: IncidenceMatrix, b: IncidenceMatrix) -> IncidenceMatrix:
     """Algorithm 1's union of two matrices of one numbering (``b``'s other ends win)."""
     done = a._completed | b._completed
-    selections = a._selections | b._selections
-    settled = (a._out & b._completed) | (b._out & a._completed)
-    if settled:  # out on one side, completed on the other: the selections go
-        choice_mask = a.numbering.choice_mask
-        while settled:
-            low = settled & -settled
-            selections &= ~choice_mask[low.bit_length() - 1]
-            settled ^= low
+    out = (a._out | b._out) & ~done  # out on one side, completed on the other: not out
+    selections = a._selections
+    if selections is not b._selections:
+        selections = tuple([(x | y) & out for x, y in zip(selections, b._selections)])
     moved = _UNMOVED
     if a._moved or b._moved:
         moved = {i: e for i, e in a._moved.items() if not b._completed >> i & 1}
         moved.update(b._moved)
     return IncidenceMatrix._of(
-        a.numbering, a._tags | b._tags, a._ends | b._ends, done, (a._out | b._out) & ~done,
+        a.numbering, a._tags | b._tags, a._ends | b._ends, done, out,
         selections, moved, a._first if a._completed else b._first, a._blocked | b._blocked)
 
 
@@ -614,11 +763,10 @@ def _contains(a: IncidenceMatrix, b: IncidenceMatrix) -> bool:
     if b._tags & ~a._tags or b._completed & ~a._completed or (
             b._blocked and b._blocked & ~a._blocked):
         return False
-    missing = b._selections & ~a._selections
-    if missing:  # selections of ends a knows as completed do not count
-        choice_mask, settled = a.numbering.choice_mask, b._out & a._completed
-        while settled:
-            low = settled & -settled
-            missing &= ~choice_mask[low.bit_length() - 1]
-            settled ^= low
-    return not missing
+    if b._selections is a._selections:
+        return True
+    done = a._completed  # selections of ends a knows as completed do not count
+    for x, y in zip(b._selections, a._selections):
+        if x & ~(y | done):
+            return False
+    return True

@@ -22,10 +22,10 @@ from algorithms.exploration.base import (
 )
 from algorithms.exploration.beacon_ids import beacon_id, robot_letters
 from algorithms.exploration.incidence_matrix import (
-    EMPTY,
     UNEXPLORED,
     End,
     IncidenceMatrix,
+    Numbering,
     merge,
 )
 
@@ -47,11 +47,10 @@ class MapStrategy(Strategy):
 
     After :meth:`first_step`, ``self.here`` is the tag of the current vertex,
     ``self.arrival`` the angle (at this vertex) of the edge the robot came by, or 2*pi
-    (the +x reference) when it did not move; ``self.matrix`` is ``In(Rk)``. The matrices
-    a robot writes use its matrix's numbering
-    (:class:`~algorithms.exploration.incidence_matrix.Numbering`): the robot that drops the
-    first beacon starts one, the others take it with the first beacon they read, so a team
-    shares one.
+    (the +x reference) when it did not move; ``self.matrix`` is ``In(Rk)``, empty at the
+    start. The matrices a robot writes use its own team numbering
+    (:class:`~algorithms.exploration.incidence_matrix.Numbering`); what it reads from a
+    beacon :func:`merge` writes in it.
     """
 
     record_type: type[VertexRecord] = VertexRecord
@@ -59,7 +58,7 @@ class MapStrategy(Strategy):
     def __init__(self, index, n_robots, rng=None):
         super().__init__(index, n_robots, rng)
         self.letters = robot_letters(index)
-        self.matrix: IncidenceMatrix = EMPTY
+        self.matrix = IncidenceMatrix({}, {}, {}, Numbering(self.letters, n_robots))
         self.here: str | None = None
         self.arrival: float = TWO_PI
         self.root: str | None = None
@@ -88,6 +87,8 @@ class MapStrategy(Strategy):
             tag = beacon.id
             before = record.matrix
             row = self.stored_angles = before.angles(tag)
+            if before.numbering is not self.matrix.numbering:  # a teammate's: its names
+                record.matrix = self.matrix.numbering.learn(before)
         matrix = self.matrix
         if arrived_by is not None and self._left_by is not None:
             self.arrival = match_angle(normalize_angle(arrived_by), row)
