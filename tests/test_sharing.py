@@ -1,6 +1,7 @@
 """Nothing mutable is reachable from two robots' controllers: a robot's knowledge, its
-incidence matrix and whatever numbers its bits, is its own or an immutable value. After a short run of each world, the object graph of every controller of the
-loop (robots, and the fixed radio nodes where there are some) is walked: attributes,
+incidence matrix and whatever numbers its bits, is its own or an immutable value. After
+a short run of each world, the object graph of every controller of the loop (robots,
+and the fixed radio nodes where there are some) is walked: attributes,
 ``__slots__``, containers, bound methods' objects, to a bounded depth. Values that cannot
 change (numbers, strings, bytes, enum members, code) end a path; tuples, frozensets and
 frozen dataclasses are walked but may be shared; a read-only mapping view is walked and
