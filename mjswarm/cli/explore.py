@@ -362,6 +362,10 @@ def summary(result: dict) -> str:
     else:
         why = result.get("reason") or result.get("ended_because") or "max time"
         lines = [head, f"not completed ({why}): no robot declared completion", traversals]
+        if result.get("infeasible"):
+            lines.append("infeasible is the tether's stall verdict (rule 5): no robot reached "
+                         "a new edge for a while; a larger team or a longer radio range may "
+                         "complete the arena")
     if "radio_range_m" in result:
         lines.append(
             f"radio {result['radio_range_m']:g} m"
