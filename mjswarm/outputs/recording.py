@@ -646,13 +646,7 @@ class Recorder:
                     [[(*where[a], z + 0.005), (*where[b], z + 0.005)] for a, b in ends],
                     colors=[robot_color(int(a[1:]) - 1) for a, _ in ends], radii=0.012))
         if truth is not None or beliefs:
-            if isinstance(truth, Mapping):
-                lines = [f"{ids[i]}: {beliefs.get(i, '-')} (truth: {truth.get(i, '-')})"
-                         for i in range(n)]
-            else:
-                lines = [] if truth is None else [f"truth: {truth}"]
-                lines += [f"{ids[i]}: {beliefs[i]}" for i in sorted(beliefs)]
-            self._stream.log("radio/truth", rr.TextDocument("\n".join(lines)))
+            self._stream.log("radio/truth", rr.TextDocument(_truth_text(ids, beliefs, truth)))
 
     def _positions(self) -> np.ndarray | None:
         """(N, 2) latest logged robot positions (m), buffered or sent; None before any."""
@@ -736,6 +730,17 @@ def graph_bounds(bounds_m: tuple[float, float, float, float], scale: float,
     x0, y0, x1, y1 = bounds_m
     return rrb.VisualBounds2D(x_range=[scale * (x0 - margin_m), scale * (x1 + margin_m)],
                               y_range=[-scale * (y1 + margin_m), -scale * (y0 - margin_m)])
+
+
+def _truth_text(ids: list[str], beliefs: Mapping[int, str],
+                truth: str | Mapping[int, str] | None) -> str:
+    """The radio truth panel: each robot's belief, with the truth (one for the team, or
+    one per robot)."""
+    if isinstance(truth, Mapping):
+        return "\n".join(f"{ids[i]}: {beliefs.get(i, '-')} (truth: {truth.get(i, '-')})"
+                         for i in range(len(ids)))
+    lines = [] if truth is None else [f"truth: {truth}"]
+    return "\n".join(lines + [f"{ids[i]}: {beliefs[i]}" for i in sorted(beliefs)])
 
 
 def _belief_colors(n: int, beliefs: Mapping[int, str],
