@@ -3,15 +3,12 @@ robot R2 b1, b2, ..., and so on.
 
 The paper stops at the alphabet. Beyond 26 robots the letters continue in bijective
 base 26, like spreadsheet columns: R27 is ``aa``, R28 ``ab``, ..., R52 ``az``, R53 ``ba``.
-A name is letters then digits, so it can always be split back unambiguously.
+A name is letters then digits, so no two robots' beacons share a name.
 """
 
 from __future__ import annotations
 
 import functools
-import re
-
-_NAME = re.compile(r"([a-z]+)([1-9][0-9]*)")
 
 
 @functools.cache  # a robot names every beacon it drops with them
@@ -33,14 +30,3 @@ def beacon_id(index: int, sequence: int) -> str:
         raise ValueError(f"beacon sequence numbers start at 1, got {sequence}")
     return f"{robot_letters(index)}{sequence}"
 
-
-def parse_beacon_id(name: str) -> tuple[int, int]:
-    """Inverse of :func:`beacon_id`: ``(robot index, sequence)``."""
-    match = _NAME.fullmatch(name)
-    if match is None:
-        raise ValueError(f"not a beacon id: {name!r}")
-    letters, digits = match.groups()
-    n = 0
-    for ch in letters:
-        n = n * 26 + (ord(ch) - ord("a") + 1)
-    return n - 1, int(digits)
