@@ -124,21 +124,6 @@ def epsilons(k: int, largest: float = 0.5, spread: float = 1.5) -> list[float]:
     return eps[::-1]
 
 
-def satisfies_28(eps: list[float]) -> bool:
-    """Check eq. (28) for a team of ``len(eps)`` robots (``<=`` within a robot's terms)."""
-    k = len(eps)
-    if k == 1:  # a lone robot meets nobody
-        return 0.0 < eps[0] < 1.0
-    chain = []
-    for e in eps:
-        chain += [e, (k - 1) * e]
-    for (a, b), i in zip(itertools.pairwise(chain), range(len(chain) - 1)):
-        same_robot = i % 2 == 0
-        if not (a <= b if same_robot else a < b):
-            return False
-    return chain[-1] < 1.0
-
-
 @dataclass
 class CollisionRule:
     """One robot's speed under eqs. (27), (33), (34).

@@ -2,17 +2,33 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
 import pytest
 
-from algorithms.collision import CollisionRule, epsilons, satisfies_28
+from algorithms.collision import CollisionRule, epsilons
 from mjswarm.core.bearing import BearingSensor
 from mjswarm.core.simulation import Simulation
 from mjswarm.core.world import Pose2D, WallSegment, world_spec
 
 S = 0.05
+
+
+def satisfies_28(eps: list[float]) -> bool:
+    """Eq. (28) for a team of ``len(eps)`` robots (``<=`` within a robot's terms)."""
+    k = len(eps)
+    if k == 1:  # a lone robot meets nobody
+        return 0.0 < eps[0] < 1.0
+    chain = []
+    for e in eps:
+        chain += [e, (k - 1) * e]
+    for (a, b), i in zip(itertools.pairwise(chain), range(len(chain) - 1)):
+        same_robot = i % 2 == 0
+        if not (a <= b if same_robot else a < b):
+            return False
+    return chain[-1] < 1.0
 
 
 @pytest.mark.parametrize("k", range(1, 21))

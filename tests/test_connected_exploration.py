@@ -188,7 +188,7 @@ def test_a_robot_that_lost_its_parent_to_a_wall_asks_a_still_neighbour():
 def test_a_robot_setting_off_adopts_nobody():
     t = Tether(1, range_m=1.0)
     assert t.hear(5, [Message(Adopt(), to=1, sender=2)], {2: (0.5, 0.0)}, willing=False) == []
-    assert not t.holding
+    assert not t.children
 
 
 def test_the_leash_keeps_the_parent_in_range():
@@ -202,10 +202,10 @@ def test_a_robot_with_children_holds():
     t = Tether(1, range_m=1.0)
     out = t.hear(5, [Message(Adopt(), to=1, sender=2)], {2: (0.5, 0.0)})
     assert out == [Message(Adopted(1), to=2)]
-    assert t.holding and not t.may_step((0.0, 0.0), {BASE: (0.1, 0.0)})
+    assert t.children and not t.may_step((0.0, 0.0), {BASE: (0.1, 0.0)})
     # the child's beats name another parent and the grace is over: released
     t.hear(5 + 5, [Message(Beat((BASE,), 1, True, 9, 0), sender=2)], {2: (0.5, 0.0)})
-    assert not t.holding
+    assert not t.children
 
 
 def test_a_biconnected_robot_needs_both_parents_within_the_leash():
@@ -257,7 +257,7 @@ def test_crossing_requests_adopt_nobody():
         assert t.ask(1, (0.2, 0.0), {other: (0.3, 0.0)}) == [Message(Adopt(), to=other)]
     assert a.hear(2, [Message(Adopt(), to=1, sender=2)], {2: (0.3, 0.0)}) == []
     assert b.hear(2, [Message(Adopt(), to=2, sender=1)], {1: (0.3, 0.0)}) == []
-    assert not a.holding and not b.holding
+    assert not a.children and not b.children
 
 
 def test_stall_after_the_stated_time():

@@ -56,9 +56,27 @@ def doubly_connected(graph, v, ref):
     return any(v in c and ref in c and len(c) >= 3 for c in nx.biconnected_components(graph))
 
 
+def table_access_robots(table):
+    """Definition 1 on the table: the neighbours its stored paths start from."""
+    return frozenset(p[0] for p in table.paths)
+
+
+def disjoint_pair(table):
+    """Two internally disjoint access paths on the robot's own map (the union of its
+    stored paths), by Menger's theorem, or None."""
+    if not table.is_doubly_connected():
+        return None
+    known = nx.Graph()
+    for p in table.paths:
+        nx.add_path(known, (table.robot_id, *p))
+    a, b = nx.node_disjoint_paths(known, table.robot_id, table.reference, cutoff=2)
+    return tuple(a[1:]), tuple(b[1:])
+
+
 def knowledge(table):
-    """What a table tells its robot, independent of message order."""
-    return table.has_access_path(), table.access_robots(), table.critical_robots()
+    """What a table tells its robot, independent of message order (critical robots:
+    None without an access path)."""
+    return table_access_robots(table), table.critical_robots()
 
 
 def assert_real_access_path(graph, robot, path, ref):
@@ -108,7 +126,7 @@ def test_figure1_tables_contain_table2():
     assert tables["R1"].paths == []
     assert tick <= 5  # "terminates within l steps" (l = 4 here) plus the quiet tick
     assert tables["R7"].critical_robots() == {"R2"}
-    assert tables["R4"].access_robots() == {"R2", "R7"}
+    assert table_access_robots(tables["R4"]) == {"R2", "R7"}
 
 
 # -- the check against networkx -------------------------------------------------------
@@ -173,14 +191,14 @@ def test_tables_hold_real_paths_and_exact_knowledge(max_forwards):
             for path in table.paths:
                 assert_real_access_path(graph, v, path, ref)
             reachable = nx.has_path(graph, v, ref)
-            assert table.has_access_path() == reachable
+            assert (table.critical_robots() is not None) == reachable
             if not reachable:
                 continue
             truth = separators(graph, v, ref)
-            pair = table.disjoint_access_paths()
+            pair = disjoint_pair(table)
             if max_forwards is None:
                 assert table.critical_robots() == truth, (seed, v)
-                assert table.access_robots() == access_robots(graph, v, ref), (seed, v)
+                assert table_access_robots(table) == access_robots(graph, v, ref), (seed, v)
                 assert table.is_doubly_connected() == doubly_connected(graph, v, ref)
                 assert (pair is not None) == doubly_connected(graph, v, ref)
             else:
@@ -214,7 +232,7 @@ def test_paths_from_a_robot_that_is_not_a_neighbour_are_ignored():
     table.tick(0, [], {"a"})
     table.tick(1, [Message(sender="b", payload=NewAccessPath(("ref",), (0,)))], {"a"})
     table.tick(2, [Message(sender="a", payload=NewAccessPath(("r", "ref"), (1, 0)))], {"a"})  # a loop
-    assert table.paths == [] and not table.has_access_path()
+    assert table.paths == [] and table.critical_robots() is None
 
 
 def test_link_broken_deletes_only_paths_that_crossed_the_link_before_it_broke():

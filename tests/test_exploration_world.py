@@ -13,6 +13,7 @@ from algorithms.exploration.base import Strategy
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.graph_exploration import explore, explore_world, run_minds
 from mjswarm.experiments.minds import make_minds
+from mjswarm.experiments.results import Paths
 from mjswarm.worlds.graphworld import GraphWorld
 
 
@@ -170,3 +171,19 @@ def test_a_vertex_call_is_the_observation_built_by_name():
     expected = Observation(1, 0, beacon=o.beacon, vertex=VertexSense(world.angles[root], None))
     assert type(o) is Observation and len(o) == len(Observation._fields)
     assert o == expected and o.vertex == expected.vertex and o.leg is None
+
+
+def test_paths_keep_the_first_or_the_last_declaration_of_a_tick():
+    """Every world's path accounting (``Paths``): arrivals extend a path; of two
+    declarations the first counts in the graph worlds, the last in the embodied world."""
+    for keep, winner in (("first", 0), ("last", 1)):
+        paths = Paths(2, "r", keep=keep)
+        paths.arrive(0, "a")
+        paths.arrive(1, "b")
+        paths.declare(3.0, 0, "a", (("a1", "b1"),))
+        paths.declare(3.0, 1, "b", (("b1", "a1"),))
+        assert paths.declared == (3.0, winner, "ab"[winner])
+        assert paths.declared_map == ((("a1", "b1"),), (("b1", "a1"),))[winner]
+        assert paths.counted([1]) == [["r", "a"], ["r"]] and paths.paths[1] == ["r", "b"]
+    with pytest.raises(ValueError):
+        Paths(1, "r", keep="any")

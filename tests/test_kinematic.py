@@ -171,13 +171,22 @@ def test_no_move_ever_deepens_an_overlap_in_a_random_crowd(seed):
     assert sim.collisions.events  # the crowd did bump
 
 
+def wall_depth(discs, centre, axes, half, radius_m):
+    """How far (m) each disc (centres (K, 2), radius ``radius_m``) reaches into its
+    rectangle (negative: the gap); one rectangle (centre, unit axes as rows, half sizes)
+    per disc. The reference for ``WallGrid``."""
+    local = np.abs(np.einsum("kij,kj->ki", axes, discs - centre)) - half
+    outside = np.hypot(np.maximum(local[:, 0], 0.0), np.maximum(local[:, 1], 0.0))
+    inside = np.minimum(local.max(axis=1), 0.0)
+    return radius_m - (outside + inside)
+
+
 @pytest.mark.parametrize("seed", range(6))
 def test_the_wall_grid_finds_every_deeper_wall_overlap(seed):
     """``WallGrid.deeper`` (one compiled pass over a grid of walls) against every wall of
     ``arena2`` by the reference ``wall_depth``: discs scattered over the arena and beyond it,
     each moved a few millimetres, many of them into or out of a wall."""
     from mjswarm.arena.builder import arena_world_spec
-    from mjswarm.core.kinematic import wall_depth
 
     sim = Simulation(arena_world_spec(load_arena("arena2"), [Pose2D(0.0, 0.0, 0.0)]),
                      physics="kinematic")
@@ -258,7 +267,7 @@ def test_kinematic_wheels_follow_the_motor_filter():
     """Step 1: from rest, a wheel command u reaches u (1 - exp(-t / tau)) after t."""
     sim = Simulation(world_spec([Pose2D(0.0, 0.0)]), physics="kinematic")
     tau = sim.model.actuator_dynprm[sim._actuators[0, 0], 0]
-    sim.set_wheel_speeds(np.array([[4.0, 4.0]]))
+    sim.set_velocity(4.0 * sim.geometry.wheel_radius_m, 0.0)  # 4 rad/s on both wheels
     sim.step(5)
     t = sim.time_s - sim.model.opt.timestep  # the speed of the last physics step
     assert sim.readings()["wheel_speed"][0, 0] == pytest.approx(4.0 * (1 - math.exp(-t / tau)))

@@ -56,8 +56,6 @@ from collections.abc import Hashable, Iterable
 from itertools import pairwise
 from typing import NamedTuple
 
-import networkx as nx
-
 from algorithms.robot import Message
 
 #: ``(access robot, ..., reference)``; ``()`` is the reference's own announcement.
@@ -152,14 +150,6 @@ class ConnectivityTable:
         return list(self._forwarded)
 
     # -- what the table tells the robot -------------------------------------------------
-    def has_access_path(self) -> bool:
-        """Connected to the reference (the reference itself counts as connected)."""
-        return self.is_reference or bool(self._paths)
-
-    def access_robots(self) -> frozenset:
-        """Neighbours through which this robot knows a path to the reference."""
-        return frozenset(p[0] for p in self._paths)
-
     def critical_robots(self) -> frozenset | None:
         """Robots on every stored path: each one's loss cuts this robot off the reference.
 
@@ -191,21 +181,6 @@ class ConnectivityTable:
         these sets over all robots to find whether the reference is a cut robot.
         """
         return frozenset(p[-2] if len(p) > 1 else self.robot_id for p in self._paths)
-
-    def disjoint_access_paths(self) -> tuple[AccessPath, AccessPath] | None:
-        """Two internally disjoint access paths, or None if there are none.
-
-        Found on the robot's own map (the union of its stored paths) by Menger's theorem
-        (networkx ``node_disjoint_paths``): no robot of that map is on every path of it, so
-        two disjoint ones exist in it, though they may splice stored paths.
-        """
-        if not self.is_doubly_connected():
-            return None
-        known = nx.Graph()
-        for p in self._paths:
-            nx.add_path(known, (self.robot_id, *p))
-        a, b = nx.node_disjoint_paths(known, self.robot_id, self.reference, cutoff=2)
-        return tuple(a[1:]), tuple(b[1:])
 
     # -- one tick ---------------------------------------------------------------------
     def tick(

@@ -37,6 +37,16 @@ class VertexCalled(NamedTuple):
     matrix: Any = None
 
 
+def vertex_called(arrived: bool, decision, beacon, map_edges) -> VertexCalled:
+    """The report of a vertex call, in every world: whether the robot had just arrived by
+    an edge, its strategy's ``decision`` (a :class:`~algorithms.exploration.base.
+    Decision`), the ``beacon`` after the call (its id, its text and the matrix it holds,
+    if any) and the robot's map then (``map_edges``, pairs of beacon ids)."""
+    data = beacon.data
+    return VertexCalled(arrived, decision.action, decision.angle, beacon.id, repr(data),
+                        tuple(map_edges), getattr(data, "matrix", None))
+
+
 class Stopped(NamedTuple):
     """The robot stopped for good (lost its line, no beacon, an entry denied ...)."""
 

@@ -82,7 +82,7 @@ from algorithms.exploration.events import (
     SpeedChanged,
     SpeedRuleFired,
     Stopped,
-    VertexCalled,
+    vertex_called,
 )
 from algorithms.exploration.relay import ConnectedExplorer
 from algorithms.exploration.leash import Leash
@@ -594,9 +594,7 @@ class Explorer(Controller):
         self._reanchor(beacon, cx is None or cx.consulted)
         self.calls.append(VertexCall(now_s, beacon.id, arrived and not back, decision))
         mapped = tuple(self.strategy.map_edges())
-        self._events.append(VertexCalled(arrived and not back, decision.action, decision.angle,
-                                         beacon.id, repr(beacon.data), mapped,
-                                         getattr(beacon.data, "matrix", None)))
+        self._events.append(vertex_called(arrived and not back, decision, beacon, mapped))
         self._decided(decision, now_s, mapped, out)
 
     def _reanchor(self, beacon, consulted: bool) -> None:

@@ -18,7 +18,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from algorithms.exploration.base import Strategy, angle_gap
-from algorithms.exploration.events import Declared, Infeasible, VertexCalled
+from algorithms.exploration.events import Declared, Infeasible, vertex_called
 from algorithms.exploration.leash import Leash
 from algorithms.exploration.relay import MODES, ConnectedExplorer
 from algorithms.exploration.tether import BASE
@@ -44,7 +44,8 @@ class GraphExplorer(Controller):
         decision = self.strategy.on_vertex(observation.beacon, vertex.angles_rad,
                                            vertex.arrived_by_rad)
         if self.report:
-            call = vertex_called(observation, decision, self.strategy)
+            call = vertex_called(vertex.arrived_by_rad is not None, decision, observation.beacon,
+                                 self.strategy.map_edges())
             events = (call, Declared(call.map_edges)) if decision.action == "done" else (call,)
             return Command(edge_rad=decision.angle if decision.action == "go" else None,
                            events=events)
@@ -70,16 +71,6 @@ class BookkeepingExplorer(GraphExplorer):
         vertex = observation.vertex
         if vertex is not None:
             self.strategy.arrive(observation.beacon, vertex.angles_rad, vertex.arrived_by_rad)
-
-
-def vertex_called(observation: Observation, decision, strategy: Strategy) -> VertexCalled:
-    """The report of a vertex call: what ``strategy`` decided, the beacon after the call
-    and the strategy's map."""
-    beacon = observation.beacon
-    data = beacon.data
-    return VertexCalled(observation.vertex.arrived_by_rad is not None, decision.action,
-                        decision.angle, beacon.id, repr(data), tuple(strategy.map_edges()),
-                        getattr(data, "matrix", None))
 
 
 def graph_explorer(strategy: Strategy, report: bool = False) -> GraphExplorer:
@@ -155,8 +146,10 @@ class TetheredExplorer(Controller):
         self._wanted, self._moved, self._back = None, False, False
         steps, progress, edge_rad = leg.steps_m, leg.progress, None
         if vertex is not None:
-            decision = c.on_vertex(observation.beacon, vertex.angles_rad, vertex.arrived_by_rad)
-            called = (vertex_called(observation, decision, c.mind),) if self.report else ()
+            beacon, arrived_by = observation.beacon, vertex.arrived_by_rad
+            decision = c.on_vertex(beacon, vertex.angles_rad, arrived_by)
+            called = (vertex_called(arrived_by is not None, decision, beacon,
+                                    c.mind.map_edges()),) if self.report else ()
             if decision.action == "done":
                 return Command(messages=out,
                                events=(*called, Declared(tuple(c.mind.map_edges()))))

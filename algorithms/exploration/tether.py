@@ -129,10 +129,6 @@ class Tether:
         self.last_progress = 0  # tick
         self.known_edges = 0
 
-    @property
-    def holding(self) -> bool:
-        return bool(self.children)
-
     # -------------------------------------------------------------- one tick
     def hear(self, tick: int, inbox: Sequence[Message],
              around: Mapping[Hashable, Sequence[float]], willing: bool = True) -> list[Message]:

@@ -222,9 +222,9 @@ class WallGrid:
     (W, 2), metres). A uniform grid of ``WALL_CELL_M`` cells over the walls lists in each
     cell every wall whose bounding box, grown by the radius, meets the cell: a disc that
     reaches a wall has its centre in such a cell, and a centre outside the grid reaches
-    none. The depth is computed as :func:`wall_depth` computes it, the same operations in
-    the same order (``tests/test_kinematic.py`` checks the two against each other, and
-    against every wall, on random poses).
+    none. The depth is computed as the reference ``wall_depth`` of ``tests/test_kinematic.py``
+    computes it over arrays, the same operations in the same order (the test checks the
+    two against each other, and against every wall, on random poses).
     """
 
     def __init__(self, centre: np.ndarray, axes: np.ndarray, half: np.ndarray,
@@ -255,20 +255,10 @@ class WallGrid:
                        self.centre, self.axes, self.half, self.radius_m, OVERLAP_TOL_M)
 
 
-def wall_depth(discs: np.ndarray, centre: np.ndarray, axes: np.ndarray, half: np.ndarray,
-               radius_m: float) -> np.ndarray:
-    """How far (m) each disc (centres (K, 2), radius ``radius_m``) reaches into its
-    rectangle (negative: the gap); one rectangle (centre, unit axes as rows, half sizes)
-    per disc. The reference for :class:`WallGrid`."""
-    local = np.abs(np.einsum("kij,kj->ki", axes, discs - centre)) - half
-    outside = np.hypot(np.maximum(local[:, 0], 0.0), np.maximum(local[:, 1], 0.0))
-    inside = np.minimum(local.max(axis=1), 0.0)
-    return radius_m - (outside + inside)
-
-
 @njit(cache=True)
 def _depth(x, y, centre, axes, half, w, radius):  # pragma: no cover (compiled)
-    """:func:`wall_depth` of one disc centred at ``(x, y)`` in wall ``w``."""
+    """How far (m) the disc centred at ``(x, y)`` reaches into wall ``w`` (negative: the
+    gap)."""
     dx, dy = x - centre[w, 0], y - centre[w, 1]
     l0 = abs(axes[w, 0, 0] * dx + axes[w, 0, 1] * dy) - half[w, 0]
     l1 = abs(axes[w, 1, 0] * dx + axes[w, 1, 1] * dy) - half[w, 1]

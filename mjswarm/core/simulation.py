@@ -258,17 +258,6 @@ class Simulation:
         return np.array(own, np.int64)
 
     # ------------------------------------------------------------------ commands
-    def set_wheel_speeds(self, omega_rad_s: np.ndarray) -> None:
-        """Command wheel angular speeds (rad/s), shape (N, 2) as (left, right).
-
-        The velocity actuators clamp each wheel to +-``max_wheel_speed_rad_s``, so no
-        robot exceeds its top speed (20 cm/s).
-        """
-        omega = np.asarray(omega_rad_s, dtype=np.float64).reshape(self.n, 2)
-        if not np.all(np.isfinite(omega)):
-            raise MjswarmError("wheel speed commands must be finite")
-        self.data.ctrl[self._actuators] = omega
-
     def set_velocity(self, v_m_s: np.ndarray, omega_rad_s: np.ndarray) -> None:
         """Command unicycle velocities: forward ``v`` (m/s) and turn rate ``omega`` (rad/s).
 
@@ -431,14 +420,6 @@ class Simulation:
             self._poses = poses
             self._poses_version = self.state_version
         return self._poses.copy()
-
-    def heights(self) -> np.ndarray:
-        """Ground-truth axle heights (m), shape (N,)."""
-        return self.data.qpos[self._qpos_adr + 2].copy()
-
-    def uprightness(self) -> np.ndarray:
-        """Cosine of each chassis's tilt from vertical, shape (N,) (1 = upright)."""
-        return self.data.xmat[self.robot_bodies][:, 8].copy()
 
     def warnings(self) -> dict[str, int]:
         """MuJoCo warnings raised so far, by name (empty when none)."""

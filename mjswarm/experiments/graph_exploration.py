@@ -24,7 +24,7 @@ from algorithms.exploration.events import Declared
 from algorithms.exploration.graph_explorer import graph_explorer
 from algorithms.robot import Controller
 from mjswarm.experiments.minds import StrategyFactory, make_minds, strategy_name
-from mjswarm.experiments.results import ExplorationResult, outcome
+from mjswarm.experiments.results import ExplorationResult, Paths
 from mjswarm.worlds.graphworld import GraphWorld
 from mjswarm.worlds.loop import Loop, LoopFunctions
 
@@ -41,9 +41,7 @@ class GraphExploration(LoopFunctions):
                  max_time: float | None = None, arena: str = "<graph>") -> None:
         self.world, self.strategy, self.seed, self.arena = world, strategy, seed, arena
         self.max_time = default_max_time(world) if max_time is None else max_time
-        self.paths = [[world.root] for _ in range(world.n)]
-        self.declared: tuple[float, int, str] | None = None
-        self.declared_map: tuple[tuple[str, str], ...] = ()
+        self.paths = Paths(world.n, world.root, keep="first")
         self._now = 0.0
 
     def before_step(self, loop: Loop) -> None:
@@ -51,30 +49,27 @@ class GraphExploration(LoopFunctions):
 
     def after_step(self, loop: Loop) -> None:
         at, paths = self.world.at, self.paths
+        route = paths.paths
         for i in loop.stepped:  # a robot that set out: its path gains the far end
-            if at[i] != paths[i][-1]:
-                paths[i].append(at[i])
+            if at[i] != route[i][-1]:
+                paths.arrive(i, at[i])
         for i, event in loop.reports:
-            if isinstance(event, Declared) and self.declared is None:
-                self.declared = (self._now, i, at[i])
-                self.declared_map = event.map_edges
+            if isinstance(event, Declared):
+                paths.declare(self._now, i, at[i], event.map_edges)
 
     def should_stop(self, loop: Loop) -> bool:
         world = self.world
-        return self.declared is not None or world.idle or world.time_s > self.max_time
+        return self.paths.declared is not None or world.idle or world.time_s > self.max_time
 
     def result(self, loop: Loop) -> ExplorationResult:
-        world, declared = self.world, self.declared
-        paths = [list(p) for p in self.paths]
-        if declared is not None:
-            for j, path in enumerate(paths):  # traversals under way do not count
-                if world.arrival[j] > declared[0]:
-                    path.pop()
+        world, declared = self.world, self.paths.declared
+        under_way = () if declared is None else [  # traversals under way do not count
+            j for j in range(world.n) if world.arrival[j] > declared[0]]
         dropped = {b.id: v for v, b in world.beacons.items() if b.id is not None}
-        return ExplorationResult(**outcome(
-            self.strategy, declared, self.declared_map,
-            None if declared is None else declared[0], paths, dropped, world.edges,
-            arena=self.arena, root=world.root, edge_time=world.edge_time, seed=self.seed))
+        return ExplorationResult(**self.paths.outcome(
+            self.strategy, None if declared is None else declared[0], dropped, world.edges,
+            self.paths.counted(under_way), arena=self.arena, root=world.root,
+            edge_time=world.edge_time, seed=self.seed))
 
 
 def run_controllers(world: GraphWorld, controllers: Sequence[Controller], strategy: str, *,

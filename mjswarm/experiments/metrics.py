@@ -9,7 +9,12 @@ trips, infeasibility verdicts and the largest odometry heading error, and says w
 run is over (:meth:`ExplorationMetrics.should_stop`).
 
 Events are accounted at the state the robots observed in the tick (as when they decided):
-the time and true poses taken at the start of the tick.
+the time and true poses taken at the start of the tick. A path gains a vertex at a vertex
+call after an arrival; a declaration counts at the vertex call that decides ``"done"``
+(the :class:`~algorithms.exploration.events.Declared` that follows carries the same map),
+and of two declarations in one tick the last counts (``Paths(keep="last")``: the graph
+worlds keep the first; the embodied world keeps its own rule, so its results stay as
+they are).
 """
 
 from __future__ import annotations
@@ -20,7 +25,6 @@ from collections.abc import Callable, Iterable, Mapping
 import networkx as nx
 
 from algorithms.exploration.events import (
-    Declared,
     Infeasible,
     RelayTrip,
     SpeedChanged,
@@ -28,6 +32,7 @@ from algorithms.exploration.events import (
     Stopped,
     VertexCalled,
 )
+from mjswarm.experiments.results import Paths
 from mjswarm.worlds.loop import Loop, LoopFunctions
 
 
@@ -73,11 +78,9 @@ class ExplorationMetrics(LoopFunctions):
         self.world, self.roster, self.nearest = world, roster, nearest
         self.stall_timeout_s = stall_timeout_s
         self.infeasible_reason = infeasible_reason
-        k = world.n
-        self.paths = [[root] for _ in range(k)]
+        #: the paths and the declaration; of two declarations in one tick the last counts
+        self.record = Paths(world.n, root, keep="last")
         self.beacon_vertex: dict[str, str] = {}
-        self.declared: tuple[float, int, str] | None = None
-        self.declared_map: tuple = ()
         self.stopped: list[dict] = []
         self.speed_changes = 0
         self.relay_trips = 0
@@ -113,8 +116,6 @@ class ExplorationMetrics(LoopFunctions):
                 if i not in self.roster.finished:
                     self._stop(i, event.reason, now)
                 self.roster.finished.add(i)
-            elif kind is Declared:
-                self.declared_map = event.map_edges
             elif kind is RelayTrip:
                 self.relay_trips += 1
             elif kind is Infeasible:
@@ -129,13 +130,13 @@ class ExplorationMetrics(LoopFunctions):
     def _vertex_called(self, loop: Loop, i: int, call: VertexCalled, now: float) -> None:
         vertex = self.nearest(i)[0]  # where it stands (its beacon was served)
         if call.arrived:
-            self.paths[i].append(vertex)
+            self.record.arrive(i, vertex)
             self.roster.last_progress_s = now
             loop.event(f"R{i + 1} at {vertex}", i)
         if call.beacon_id is not None:
             self.beacon_vertex.setdefault(call.beacon_id, vertex)
         if call.action == "done":
-            self.declared = (now, i, vertex)
+            self.record.declare(now, i, vertex, call.map_edges)
             self.roster.finished.add(i)
             loop.event(f"R{i + 1} declares completion at {vertex}", i)
             loop.event(f"R{i + 1} declared completion at {vertex}")
@@ -175,6 +176,21 @@ class ExplorationMetrics(LoopFunctions):
         else:
             return False
         return True
+
+    @property
+    def paths(self) -> list[list[str]]:
+        """Each robot's path of vertices (:class:`~mjswarm.experiments.results.Paths`)."""
+        return self.record.paths
+
+    @property
+    def declared(self) -> tuple[float, int, str] | None:
+        """``(time s, robot index, vertex)`` of the declaration that counts, or None."""
+        return self.record.declared
+
+    @property
+    def declared_map(self) -> tuple:
+        """The declaring robot's map (pairs of beacon ids)."""
+        return self.record.declared_map
 
     @property
     def traversals(self) -> int:

@@ -60,7 +60,7 @@ from mjswarm.core.radio import BASE_MAST_M
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.graph_exploration import default_max_time
 from mjswarm.experiments.minds import strategy_name
-from mjswarm.experiments.results import ExplorationResult, outcome
+from mjswarm.experiments.results import ExplorationResult, Paths
 from mjswarm.worlds.graphworld import GraphWorld
 from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.radiograph import ANSWER, TICKS_PER_UNIT, RadioGraphWorld
@@ -127,9 +127,7 @@ class ConnectedExploration(LoopFunctions):
         self.world, self.strategy, self.connectivity = world, strategy, connectivity
         self.seed, self.arena = seed, arena
         root = world.graph.root
-        self.paths = [[root] for _ in range(world.n)]
-        self.declared: tuple[float, int, str] | None = None
-        self.declared_map: tuple[tuple[str, str], ...] = ()
+        self.paths = Paths(world.n, root, keep="first")
         self.infeasible: int | None = None
         self.ticks = self.cut = self.fragile = 0
         self._base_xy = world.pos[root][None]
@@ -140,10 +138,10 @@ class ConnectedExploration(LoopFunctions):
             self.ticks = w.tick
             for i, event in loop.reports:
                 if isinstance(event, Declared):
-                    self.declared, self.declared_map = (w.time_s, i, w.at[i]), event.map_edges
+                    self.paths.declare(w.time_s, i, w.at[i], event.map_edges)
                     return  # the run ends: the steps of this tick do not count
             for i in w.arrived:
-                self.paths[i].append(w.at[i])
+                self.paths.arrive(i, w.at[i])
             return
         if self.infeasible is None and any(isinstance(e, Infeasible) for _, e in loop.reports):
             self.infeasible = self.ticks
@@ -152,7 +150,7 @@ class ConnectedExploration(LoopFunctions):
         self.fragile += not nx.is_biconnected(graph)
 
     def should_stop(self, loop: Loop) -> bool:
-        return self.declared is not None or self.infeasible is not None
+        return self.paths.declared is not None or self.infeasible is not None
 
     def _radio_graph(self, xy: np.ndarray) -> nx.Graph:
         """Ground truth: the radio graph of the robots and the base (the last node)."""
@@ -163,12 +161,12 @@ class ConnectedExploration(LoopFunctions):
         return g
 
     def result(self, loop: Loop) -> ConnectedExplorationResult:
-        w, declared, paths = self.world, self.declared, self.paths
+        w, declared, paths = self.world, self.paths.declared, self.paths.paths
         g = w.graph
         dropped = {b.id: v for v, b in w.beacons.items() if b.id is not None}
-        fields = outcome(self.strategy, declared, self.declared_map,
-                         None if declared is None else declared[0], paths, dropped, g.edges,
-                         arena=self.arena, root=g.root, edge_time=g.edge_time, seed=self.seed)
+        fields = self.paths.outcome(self.strategy, None if declared is None else declared[0],
+                                    dropped, g.edges, arena=self.arena, root=g.root,
+                                    edge_time=g.edge_time, seed=self.seed)
         reason = None if self.infeasible is None else infeasible_reason(
             w.n, w.range_m, paths, len(g.edges))
         ticks = max(self.ticks, 1)

@@ -41,6 +41,53 @@ class ExplorationResult:
         return d
 
 
+class Paths:
+    """Each robot's path of vertices from the root, and the team's declaration of
+    completion: what every world accounts the same way, while each world keeps its own
+    timing (when a path gains a vertex, which declaration of a tick it hears).
+
+    ``paths[i]`` is robot ``i``'s path; ``declared`` is ``(time, robot index, vertex)``
+    or None, ``declared_map`` the declaring robot's map (pairs of beacon ids). ``keep``
+    says which of two declarations of one tick counts: ``"first"`` (the graph worlds) or
+    ``"last"`` (the embodied world: the robot that steps last in the tick).
+    """
+
+    def __init__(self, n: int, root: str, keep: str = "first") -> None:
+        if keep not in ("first", "last"):
+            raise ValueError(f"keep must be 'first' or 'last', not {keep!r}")
+        self.paths = [[root] for _ in range(n)]
+        self.declared: tuple[float, int, str] | None = None
+        self.declared_map: tuple[tuple[str, str], ...] = ()
+        self._last = keep == "last"
+
+    def arrive(self, i: int, vertex: str) -> None:
+        """Robot ``i``'s path gains ``vertex``."""
+        self.paths[i].append(vertex)
+
+    def declare(self, now: float, i: int, vertex: str,
+                map_edges: tuple[tuple[str, str], ...]) -> None:
+        """Robot ``i`` declared completion at ``vertex`` at time ``now`` with its map
+        ``map_edges``; a later declaration counts only under ``keep="last"``."""
+        if self.declared is None or self._last:
+            self.declared, self.declared_map = (now, i, vertex), map_edges
+
+    def counted(self, under_way=()) -> list[list[str]]:
+        """A copy of the paths without the last vertex of each robot of ``under_way``
+        (its traversal still under way at the declaration does not count)."""
+        paths = [list(p) for p in self.paths]
+        for i in under_way:
+            paths[i].pop()
+        return paths
+
+    def outcome(self, strategy: str, makespan: float | None, beacon_vertex: Mapping[str, str],
+                true_edges: set[tuple[str, str]], paths: list[list[str]] | None = None,
+                **run) -> dict:
+        """:func:`outcome` of these paths (or of ``paths``) and this declaration."""
+        return outcome(strategy, self.declared, self.declared_map, makespan,
+                       self.paths if paths is None else paths, beacon_vertex, true_edges,
+                       **run)
+
+
 def outcome(strategy: str, declared: tuple[float, int, str] | None,
             declared_map: Iterable[tuple[str, str]], makespan: float | None,
             paths: list[list[str]], beacon_vertex: Mapping[str, str],

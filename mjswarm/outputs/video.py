@@ -376,11 +376,6 @@ class Video(LoopFunctions):
                 draw.line((left + 5, row, left + 21, row), fill=rgb, width=2)
             draw.text((left + 26, row), text, fill="black", font=self._small, anchor="lm")
 
-    @property
-    def frames(self) -> int:
-        """Frames written so far."""
-        return len(self.frame_times_s)
-
     def close(self) -> None:
         """Finish the file (call once the run is over)."""
         if self._writer is not None:

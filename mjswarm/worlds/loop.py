@@ -295,6 +295,9 @@ class Loop:
         self._on_floor: set = set()  # robots reset since they last entered the floor
         self._departures = world.departures  # the world's count when _on_floor was taken
         self._stop = False
+        #: how the robots are controlled (a team, or one controller each) and reset
+        self._control = self._control_each if team is None else self._control_team
+        self._reset = self._reset_each if team is None else team.reset
         for f in functions:
             self.add(f)
 
@@ -330,36 +333,12 @@ class Loop:
 
     def step(self) -> None:
         """One control tick (module docstring)."""
-        world, controllers = self.world, self.controllers
+        world = self.world
         for f in self.functions:
             f.before_step(self)
         robots = world.active()
         self._enter(robots)
-        team, members = self.team, ()
-        if team is not None:  # the team's robots are stepped as arrays, the nodes one by one
-            members, robots = robots, []
-        nodes = world.nodes
-        if nodes:
-            robots = [*nodes, *robots]
-        observe, act = world.observe, world.act
-        observations = [observe(i) for i in robots]
-        if team is not None:
-            readings = world.observe_all(members)
-        if self._perceive:
-            for i, o in zip(robots, observations):
-                controllers[i].perceive(o)
-        commands = [controllers[i].step(o) for i, o in zip(robots, observations)]
-        if team is not None:
-            team_commands = team.step_all(readings)
-        reports = []
-        for i, command in zip(robots, commands):
-            act(i, command)
-            if command.events:
-                reports += [(i, event) for event in command.events]
-        if team is not None:
-            world.act_all(members, team_commands)
-            robots = [*robots, *members]
-        self.stepped, self.reports = robots, reports
+        self.stepped, self.reports = self._control(robots)
         world.step()
         self.ticks += 1
         for f in self.functions:
@@ -368,6 +347,48 @@ class Loop:
             if f.should_stop(self):
                 self._stop = True
                 break
+
+    def _control_each(self, robots: list) -> tuple[list, list]:
+        """Sense, control and act for the fixed nodes and ``robots``, one by one; the
+        robots stepped and their reports."""
+        nodes = self.world.nodes
+        if nodes:
+            robots = [*nodes, *robots]
+        observe = self.world.observe
+        observations = [observe(i) for i in robots]
+        return robots, self._act(robots, self._decide(robots, observations))
+
+    def _control_team(self, members: list) -> tuple[list, list]:
+        """The same phases with a batched team: the nodes one by one, the team's
+        ``members`` as arrays after them in each phase."""
+        world, team = self.world, self.team
+        nodes = list(world.nodes)
+        observe = world.observe
+        observations = [observe(i) for i in nodes]
+        readings = world.observe_all(members)
+        commands = self._decide(nodes, observations)
+        team_commands = team.step_all(readings)
+        reports = self._act(nodes, commands)
+        world.act_all(members, team_commands)
+        return [*nodes, *members], reports
+
+    def _decide(self, robots: list, observations: list[Observation]) -> list[Command]:
+        """Control: each robot's controller perceives (if any has a perceive() of its
+        own), then each steps."""
+        controllers = self.controllers
+        if self._perceive:
+            for i, o in zip(robots, observations):
+                controllers[i].perceive(o)
+        return [controllers[i].step(o) for i, o in zip(robots, observations)]
+
+    def _act(self, robots: list, commands: list[Command]) -> list[tuple[Any, Any]]:
+        """Act: apply each command; the ``(robot, event)`` pairs they report, in order."""
+        act, reports = self.world.act, []
+        for i, command in zip(robots, commands):
+            act(i, command)
+            if command.events:
+                reports += [(i, event) for event in command.events]
+        return reports
 
     def _enter(self, robots: list) -> None:
         """Reset the controllers of robots that entered the floor since the last tick
@@ -381,9 +402,9 @@ class Loop:
             return
         entering = [i for i in robots if i not in on_floor]
         on_floor.update(entering)
-        if self.team is not None:
-            self.team.reset(entering)
-            return
+        self._reset(entering)
+
+    def _reset_each(self, entering: list) -> None:
         for i in entering:
             self.controllers[i].reset()
 
