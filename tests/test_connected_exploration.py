@@ -411,6 +411,7 @@ def test_embodied_connected_runs_are_deterministic():
     assert (poses_a == poses_b).all() and rest_a == rest_b
 
 
+@pytest.mark.slow  # the navigator's retrace is held by tests/test_navigator_states.py
 def test_embodied_a_retrace_off_the_lanes_start_loses_nobody():
     """hex:3x3, 6 robots at 3 m, 10 cm/s: R3 finds its lane at 270.00 s, a wall cuts its
     parent's link two ticks later, and the leash's retrace backs its centre sensor off
