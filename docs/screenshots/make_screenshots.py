@@ -1,8 +1,9 @@
 """Regenerate the screenshots of recordings in rerun's web viewer (docs/screenshots/*.png).
 
 Makes the recordings (the main job, ``mjswarm explore --arena arena2 --robots 4``;
-Nagavarapu et al.'s Fig. 9 in the graph world, plain and connected with a 1.5 m radio; a patrol and a
-biconnected coverage run in the point world), serves each with rerun's web viewer on 127.0.0.1, opens it in a headless
+Nagavarapu et al.'s Fig. 9 in the graph world, plain and connected with a 2 m radio
+that walls block; a patrol and a biconnected coverage run in the point world), serves
+each with rerun's web viewer on 127.0.0.1, opens it in a headless
 Chromium (:mod:`mjswarm.outputs.webview`: needs ``apt-get install chromium
 chromium-driver`` and selenium) and saves the default layout as ``NAME.png``, and for the
 Fig. 9 graph run and the main job each view of it as ``NAME_VIEW.png``. Run from the
