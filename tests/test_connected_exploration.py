@@ -361,6 +361,7 @@ def embodied(arena: str, robots: int, range_m: float, seed: int | None = None,
         radio_range_m=range_m, connectivity=connectivity, **config), seed=seed)
 
 
+@pytest.mark.slow  # test_embodied_connected_runs_are_deterministic runs the same kind of team
 def test_embodied_with_range_to_spare_changes_nothing():
     """arena1, 2 robots, 3 m: the tether never binds, the run is the unconstrained one
     (5 / 10, 237.9 s), with 0 contacts and every robot linked to the base every tick."""

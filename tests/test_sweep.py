@@ -58,6 +58,7 @@ def test_ray_backend_on_a_local_two_cpu_instance(tmp_path):
         assert r["makespan"] == local[tuple(r[k] for k in CELL_KEYS)]
 
 
+@pytest.mark.slow  # the connected MuJoCo team is held by tests/test_connected_exploration.py
 def test_embodied_cell_runs_with_a_constraint():
     """An embodied cell of the connected-exploration grid: the MuJoCo robots on their tether."""
     record = run_cell(Cell("embodied", "arena1", 2, "incidence-dfs", 0, 3.0, "connected"))
