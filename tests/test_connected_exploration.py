@@ -4,7 +4,6 @@ ground-truth check, infeasibility, and the CLI."""
 from __future__ import annotations
 
 import json
-import math
 
 import pytest
 
@@ -184,43 +183,6 @@ def test_a_robot_that_lost_its_parent_to_a_wall_asks_a_still_neighbour():
                Message(Beat((BASE,), 1, True, 0, 0), sender=1)], around)
     assert t.ask(1, (0.004, 0.0), around) == []
     assert t.ask(2, (0.004, 0.0), around, cut={0}) == [Message(Adopt(), to=1)]
-
-
-def test_a_parent_keeps_a_silent_child_for_its_silence_ticks():
-    """Rule 2 on bodies: a child whose beats stop coming (a wall came between them, and
-    it backs out of the wall's shadow) stays a child for ``silence_ticks``, so that its
-    parent does not set off and then hold once the child's beats come back (``arena2``,
-    4 robots at 1.5 m). A beat naming another parent ends it at once; points keep none."""
-    named = Message(Beat((1,), 2, False, 0, 0), sender=2)
-    other = Message(Beat((BASE,), 1, False, 0, 0), sender=2)
-    body, point = Tether(1, range_m=1.0, silence_ticks=3), Tether(1, range_m=1.0)
-    for t in (body, point):
-        t.hear(10, [named], {2: (0.5, 0.0)})
-        assert t.children == {2}
-    for tick in (11, 12, 13):
-        body.hear(tick, [], {})
-        assert body.children == {2} and not body.may_step((0.01, 0.0), {})
-    body.hear(14, [], {})
-    assert body.children == set()
-    point.hear(11, [], {})
-    assert point.children == set()
-    body.hear(20, [named], {2: (0.5, 0.0)})
-    body.hear(21, [other], {2: (0.5, 0.0)})
-    assert body.children == set()
-
-
-def test_a_robot_put_on_the_floor_late_judges_stalls_from_its_start():
-    """Rule 5: a body launched once the root's area clears (``arena2``, 4 robots at
-    1.5 m: R4 at 364.8 s) has heard no beats yet; it judges from its start, not from
-    tick 0, and then from what the beats tell."""
-    patience = math.ceil(STALL_TIME_UNITS * TICKS_PER_UNIT)
-    t = Tether(3, range_m=1.0, ticks_per_unit=TICKS_PER_UNIT)
-    assert t.stalled(patience)
-    t.start(patience)
-    assert not t.stalled(patience) and not t.stalled(2 * patience - 1)
-    assert t.stalled(2 * patience)
-    t.hear(2 * patience, [Message(Beat((BASE,), 1, True, 2 * patience, 0), sender=0)], {})
-    assert not t.stalled(2 * patience)
 
 
 def test_a_robot_setting_off_adopts_nobody():
@@ -415,56 +377,6 @@ def test_embodied_too_short_a_range_ends_in_a_verdict():
     assert result.reason.startswith("infeasible with 2 robots at range 1.5 m: explored ")
     assert result.collisions == 0
     assert result.connected_share > 0.999
-
-
-def _arena2_events(range_m: float, until_s: float):
-    """``arena2``, 4 robots at ``range_m``, 10 cm/s, until ``until_s``: the result and the
-    run's events as ``(time s, text)``."""
-    from mjswarm.experiments.exploration import EmbodiedConfig, EmbodiedExploration
-    from mjswarm.worlds.loop import LoopFunctions
-
-    class Events(LoopFunctions):
-        def __init__(self) -> None:
-            self.seen: list[tuple[float, str]] = []
-
-        def on_event(self, loop, text: str, robot) -> None:
-            self.seen.append((round(loop.world.time_s, 2), text))
-
-    events = Events()
-    run = EmbodiedExploration(load_arena("arena2"), make_minds("incidence-dfs", 4, None),
-                              EmbodiedConfig(speed_m_s=0.1, radio_range_m=range_m,
-                                             connectivity="connected",
-                                             max_sim_time_s=until_s), None, [events])
-    return run.run(), events.seen
-
-
-@pytest.mark.slow
-def test_embodied_arena2_a_swap_that_walls_stop_is_undone():
-    """arena2, 4 robots at 2.5 m, 10 cm/s: R3 on v10 and R4 on v11 swap their vertices,
-    and walls cut both robots' links on their way out of the areas they leave: neither
-    may go on, and both ask to turn back. The stations undo the swap, both walk back, and
-    the team explores on (R2 reaches v10 after), with 0 contacts, nobody stopped and
-    every robot linked to the base in every tick."""
-    result, events = _arena2_events(2.5, 700.0)
-    undone = [t for t, text in events if text.endswith("(a swap undone)")]
-    assert len(undone) == 2 and undone[0] == undone[1]
-    assert any(t > undone[0] and text == "R2 at v10" for t, text in events)
-    assert not result.infeasible
-    assert result.collisions == 0 and result.stopped_robots == [] and result.cut_ticks == 0
-
-
-@pytest.mark.slow
-def test_embodied_arena2_a_parent_holds_through_its_childs_silence():
-    """arena2, 4 robots at 1.5 m, 10 cm/s: R1, past v3 on R2's tether, backs out of a
-    wall's shadow; R2, on v2 with its grant for v3 given back to hold for R1, keeps R1 as
-    its child through the silence instead of setting off (it would stand for good
-    holding v3, the vertex R1 must walk back to). R1 retreats through v3, R2 explores
-    v3 (an exploring arrival), and R4, put on the floor once the root clears, judges no
-    stall on its first tick."""
-    result, events = _arena2_events(1.5, 400.0)
-    assert "v3" in result.paths[1] and any(text == "R4 launched at v1" for _, text in events)
-    assert not result.infeasible
-    assert result.collisions == 0 and result.stopped_robots == [] and result.cut_ticks == 0
 
 
 def test_a_wall_hides_a_robot_from_the_base_mast():

@@ -126,7 +126,7 @@ class Tied:
     def arrive(self, *args) -> None:
         pass
 
-    arrived_back = retire = start = arrive
+    arrived_back = retire = arrive
 
     def on_vertex(self, beacon, angles, arrived_by) -> Decision:
         return self.mind.on_vertex(beacon, angles, arrived_by)

@@ -179,23 +179,6 @@ def _angle(run, u, w):
     return incidence_angle(run.spec, u, w)
 
 
-def _swapped():
-    """Robot 0 on ``u`` and robot 1 on ``w`` swap: each is granted the other's vertex
-    (the grants delivered)."""
-    run, u, w = _on_fig9()
-    entry = run.stations.entry
-    entry.target[:] = [u, w]
-    entry.grants.occupy(0, u)
-    entry.grants.occupy(1, w)
-    for i, (a, b) in enumerate(((u, w), (w, u))):
-        _tell(run, i, EntryRequest(_angle(run, a, b)))
-    run.stations.before_step(run.loop)
-    run.uplink.step()
-    for i in (0, 1):
-        run.uplink.receive_for(i)
-    return run, u, w
-
-
 def test_a_robot_turning_back_short_of_its_corridor_gets_its_vertex_back_at_once():
     run, u, w = _on_fig9()
     assert _granted(run, 0, u, w) == [EntryGranted(True, _angle(run, u, w))]
@@ -228,7 +211,16 @@ def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws()
     """In a swap each robot was given the other's vertex: one that then asks to turn back
     into its old area gets no answer (it goes on), and one that withdraws leaves the
     other waiting until it has left its area."""
-    run, u, w = _swapped()
+    run, u, w = _on_fig9()
+    run.stations.entry.target[:] = [u, w]
+    run.stations.entry.grants.occupy(0, u)
+    run.stations.entry.grants.occupy(1, w)
+    for i, (a, b) in enumerate(((u, w), (w, u))):
+        _tell(run, i, EntryRequest(_angle(run, a, b)))
+    run.stations.before_step(run.loop)
+    run.uplink.step()
+    for i in (0, 1):
+        run.uplink.receive_for(i)
     _tell(run, 0, TurnedBack(from_lane=False))
     run.uplink.step()
     assert run.uplink.receive_for(0) == [] and run.stations.entry.target == [w, u]
@@ -237,36 +229,6 @@ def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws()
     assert run.stations.entry.grants.holder == {w: 0}
     run.uplink.step()
     assert run.uplink.receive_for(0) == []  # no VertexClear for robot 0
-
-
-def test_a_swap_whose_robots_all_turn_back_is_undone():
-    """In a swap each robot holds a grant for the other's vertex; one asking to turn back gets no
-    answer (it may go on), but once the other asks too, still in the area it leaves,
-    neither can go on (``arena2``, 4 robots at 2.5 m: walls cut both robots' links on
-    their way): each gets its own vertex back, clear."""
-    run, u, w = _swapped()
-    entry = run.stations.entry
-    _tell(run, 0, TurnedBack(from_lane=False))
-    run.uplink.step()
-    assert run.uplink.receive_for(0) == [] and entry.turning == {0}
-    _tell(run, 1, TurnedBack(from_lane=False))
-    run.uplink.step()
-    for i in (0, 1):
-        assert [m.payload for m in run.uplink.receive_for(i)] == [EntryGranted(clear=True)]
-    assert entry.target == [u, w] and entry.leaving == [None, None]
-    assert entry.grants.holder == {u: 0, w: 1} and entry.turning == set()
-
-
-def test_a_robot_that_goes_on_is_no_longer_turning_back():
-    """One that asked to turn back in a swap and then left its area (LeftVertex) goes
-    on: the other's later request to turn back undoes nothing."""
-    run, u, w = _swapped()
-    entry = run.stations.entry
-    _tell(run, 0, TurnedBack(from_lane=False))
-    _tell(run, 0, LeftVertex())
-    assert entry.turning == set()
-    _tell(run, 1, TurnedBack(from_lane=False))
-    assert entry.turning == {1} and entry.target == [w, u]
 
 
 def test_a_withdrawn_clear_grant_is_taken_back():

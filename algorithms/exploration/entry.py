@@ -33,12 +33,9 @@ and every message is counted with the radio's. The protocol, from the robot's si
    U-turn clear of that area) it asks to return there and turns once it has the grant:
    at once if it never left that area, and no answer if the station gave it to another
    robot meanwhile (a swap: it goes on, and turns farther along); else when the vertex is
-   free. Once every robot of a swap has asked so, each still in the area it leaves, none
-   goes on (a tether's leash may stop them all: walls cut their links on the way out),
-   and the swap is undone: each gets its own vertex back at once. Turned on its lane
-   (``from_lane`` True, sent once it follows its new lane, out of the area ahead), it
-   waits for the vertex behind where its new lane's wall ends; both wait as a request
-   from a centre does. A robot granted a clear vertex while it
+   free. Turned on its lane (``from_lane`` True, sent once it follows its new lane, out of
+   the area ahead), it waits for the vertex behind where its new lane's wall ends; both
+   wait as a request from a centre does. A robot granted a clear vertex while it
    must hold (rule 2 of the tether: it was adopted while it waited) sends :class:`Withdraw`:
    the station takes the grant back, and the robot asks again once it has no children, so
    that it does not keep two vertex areas while it stands in one (a robot granted a
@@ -385,10 +382,6 @@ class EntryStations:
         self.closed: dict[str, tuple[int, float]] = {}
         #: robots on their way to a vertex that closed, to be told once out of every area
         self.blocked_on_way: set[int] = set()
-        #: robots still in the area they leave that asked to turn back (``TurnedBack``
-        #: short of their corridor) when the station had given that vertex to another
-        #: robot in a swap: unanswered, until every robot of the swap asks the same
-        self.turning: set[int] = set()
         #: requests dropped because their robot gave up its place in a queue
         self.gave_up = 0
         self.outbox: list[tuple[int, Any]] = []
@@ -429,8 +422,6 @@ class EntryStations:
 
     def receive(self, i: int, payload: Any, now_s: float) -> None:
         """One message from robot ``i``."""
-        if not isinstance(payload, TurnedBack):
-            self.turning.discard(i)  # it went on, or asks anew
         if isinstance(payload, EntryRequest):
             self._request(i, payload, now_s)
         elif isinstance(payload, TurnedBack):
@@ -504,8 +495,6 @@ class EntryStations:
         back = self.came_from[i]
         holder = self.grants.holder.get(back)
         if not from_lane and self.leaving[i] == back and holder not in (None, i):
-            self.turning.add(i)
-            self._undo_swap(self._swap_turning_back(i))
             return
         self.awaiting_clear.discard(i)
         self.grants.release(i, self.target[i])
@@ -518,40 +507,12 @@ class EntryStations:
             self.grants.request(i, None, back, now_s)
         self._tell_clear()
 
-    def _swap_turning_back(self, i: int) -> list[int]:
-        """The robots of a swap through robot ``i`` that all asked to turn back, each
-        still in the area it leaves, which the station gave the next one (empty if any has not)."""
-        swap, j = [i], self.grants.holder.get(self.came_from[i])
-        while j != i:
-            if j not in self.turning or j in swap or self.leaving[j] != self.came_from[j]:
-                return []
-            swap.append(j)
-            j = self.grants.holder.get(self.came_from[j])
-        return swap
-
-    def _undo_swap(self, swap: list[int]) -> None:
-        """Every robot of a swap turns back (step 5): each gets the vertex it leaves
-        back, in whose area it still is, and gives up the one granted to it."""
-        for j in swap:
-            self.grants.release(j, self.target[j])
-        for j in swap:
-            back = self.came_from[j]
-            self.turning.discard(j)
-            self.awaiting_clear.discard(j)
-            self.grants.occupy(j, back)
-            self.leaving[j], self.target[j] = None, back
-            self.outbox.append((j, EntryGranted(clear=True)))
-            self.notes.append((j, f"R{j + 1} turns back to {back} (a swap undone)"))
-        if swap:
-            self._tell_clear()
-
     def release(self, i: int, now_s: float) -> None:
         """Robot ``i`` stopped for good (or was switched off): its holds go; a station
         whose vertex area the body still occupies keeps the vertex closed (it sees the
         body, as it sees who stands on its centre) and blocks the robots that want it."""
         self.grants.release_all(i)
         self.blocked_on_way.discard(i)
-        self.turning.discard(i)
         vertex = self.sight.body_closes(i)
         self.leaving[i] = None
         self.awaiting_clear.discard(i)

@@ -220,7 +220,6 @@ class Explorer(Controller):
         self._said_speed = speed_m_s  # its speed as last reported
         self._held_still_s = 0.0  # how long the speed rule has held it still on its lane
         self._wait_from_m: float | None = None  # odometry distance where it began to wait
-        self._started = False  # whether its tether knows its first tick on the floor
 
     @property
     def finished(self) -> bool:
@@ -269,9 +268,6 @@ class Explorer(Controller):
                     self._from_station(m.payload, out, observation)
         around = {}
         if self.tether is not None:
-            if not self._started:  # its first tick on the floor: rule 5 judges from now
-                self.tether.start(now)
-                self._started = True
             around = {j: (d.range_m * math.cos(d.bearing_rad), d.range_m * math.sin(d.bearing_rad))
                       for j, d in observation.detections.items()}
             self._hear(now, observation, around, out)

@@ -21,10 +21,6 @@ rule below is ours (the papers give none for this combination):
 2. **Holding** (Kobayashi et al.'s repeater role). A robot with children does not move: it relays.
    Its children are the robots whose last beat named it as parent, and those it adopted
    in the last ``ADOPT_GRACE_TICKS`` ticks (their first beat naming it is on its way).
-   A child whose beats stop coming (a wall came between them: the child backs out of
-   its shadow, :mod:`algorithms.exploration.leash`) stays its child for the tether's
-   ``silence_ticks``; its last beat named this robot, and it will again once back in
-   reach (0 for points: their links break only when the leash lets them).
 3. **Leash.** A robot without children takes a step only if, after the step, its parents
    are within range ``R - margin - reserve`` of it, or no farther than before (a body may
    coast a little past the leash; it may always come back). A step of a walk back may use
@@ -52,10 +48,7 @@ rule below is ours (the papers give none for this combination):
    ``STALL_UNITS_PER_EDGE`` time units per known edge declares the exploration infeasible:
    a relay's round trip (rule 6, :mod:`algorithms.exploration.relay`) crosses each known
    edge at most twice each way, so past that time nobody is on the way to unblock anybody,
-   no beacon changes, and no strategy changes its mind. A robot put on the floor later
-   than the others (a body waits for the root's area to clear) knows nothing of the
-   others' arrivals until its first beats come: it judges from the tick it starts
-   (:meth:`Tether.start`).
+   no beacon changes, and no strategy changes its mind.
 
 This module is the robot side: pure Python, no simulator.
 :mod:`mjswarm.experiments.radio_exploration`
@@ -117,15 +110,12 @@ class Tether:
         reserve_m: of that leash, what only a walk back may use (rule 3): a body
             turning back on its lane sidesteps across it, and one at the end of its
             leash must still be able to (0 for points).
-        silence_ticks: how long a child whose beats stopped coming stays its child
-            (rule 2; 0 for points).
     """
 
     def __init__(self, me: Hashable, range_m: float, parents: tuple = (BASE,),
                  margin_m: float = 0.0, ticks_per_unit: int = 10,
-                 reserve_m: float = 0.0, silence_ticks: int = 0) -> None:
+                 reserve_m: float = 0.0) -> None:
         self.me = me
-        self.silence_ticks = silence_ticks
         self.leash_m = range_m - margin_m - reserve_m
         self.reserve_m = reserve_m
         self.ticks_per_unit = ticks_per_unit
@@ -133,12 +123,10 @@ class Tether:
         self.depth = 1
         self.adopted: dict[Hashable, int] = {}  # child -> tick of adoption
         self.children: set[Hashable] = set()
-        self.named: dict[Hashable, int] = {}  # child -> tick of its last beat naming it
         #: (asked robot, tick asked, the parent it would replace)
         self.request: tuple[Hashable, int, Hashable] | None = None
         self.heard: dict[Hashable, Beat] = {}
         self.last_progress = 0  # tick
-        self.started = 0  # its first tick on the floor (rule 5 judges from then)
         self.known_edges = 0
 
     # -------------------------------------------------------------- one tick
@@ -172,8 +160,8 @@ class Tether:
         if len(depths) == len(self.parents):
             self.depth = max(depths) + 1
         self.adopted = {c: t for c, t in self.adopted.items() if tick - t <= ADOPT_GRACE_TICKS}
-        self._named(tick)
-        self.children = set(self.adopted) | set(self.named)
+        self.children = set(self.adopted) | {c for c, b in self.heard.items()
+                                             if self.me in b.parents}
         return out
 
     def may_step(self, step: Sequence[float], around: Mapping[Hashable, Sequence[float]],
@@ -232,30 +220,12 @@ class Tether:
         return Message(Beat(self.parents, self.depth, not moved, self.last_progress,
                             self.known_edges))
 
-    def start(self, tick: int) -> None:
-        """It is put on the floor at ``tick``: rule 5 judges from then, not from what it
-        could not hear off the floor."""
-        self.started = tick
-
     def stalled(self, tick: int) -> bool:
-        """Rule 5: no exploring arrival known anywhere for the patience it states, since
-        it started."""
+        """Rule 5: no exploring arrival known anywhere for the patience it states."""
         patience = STALL_TIME_UNITS + STALL_UNITS_PER_EDGE * self.known_edges
-        since = max(self.last_progress, self.started)
-        return tick - since >= math.ceil(patience * self.ticks_per_unit)
+        return tick - self.last_progress >= math.ceil(patience * self.ticks_per_unit)
 
     # -------------------------------------------------------------- internals
-    def _named(self, tick: int) -> None:
-        """Rule 2's children by their beats: those heard naming it now, and those whose
-        last beat named it no more than ``silence_ticks`` ago (a beat naming another
-        parent ends it at once)."""
-        for c, b in self.heard.items():
-            if self.me in b.parents:
-                self.named[c] = tick
-            else:
-                self.named.pop(c, None)
-        self.named = {c: t for c, t in self.named.items() if tick - t <= self.silence_ticks}
-
     def _request(self, asked: Hashable, tick: int, replaced: Hashable) -> list[Message]:
         self.request = (asked, tick, replaced)
         return [Message(Adopt(), to=asked)]

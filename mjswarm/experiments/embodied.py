@@ -24,13 +24,6 @@ TETHER_MARGIN_M = 0.02
 #: sidesteps two lane offsets across its edge, with room for the odometry's back-up to
 #: where its lane ended.
 TURN_RESERVE_M = 2 * LANE_OFFSET_M + 0.02
-#: How long (s) a parent keeps a child whose beats stopped coming (the tether's
-#: ``silence_ticks``, rule 2): a wall came between them, and the child drives its last
-#: moves backwards until the link is back (:mod:`algorithms.exploration.leash`), a few
-#: control periods. A parent that took the silence for the child's leaving would set
-#: off, and stand for good once the child's beats named it again (``arena2``, 4 robots
-#: at 1.5 m: holding the vertex its child had to walk back to).
-CHILD_SILENCE_S = 1.0
 #: What pictures of a run say the marked vertices are.
 BEACON_LABEL = "beacon dropped (vertex explored)"
 #: Default stall timeout: at least this long (s), and at least STALL_EDGE_FACTOR times

@@ -109,7 +109,6 @@ from mjswarm.errors import RunInterrupted
 from mjswarm.experiments.awareness import BeliefSampling, TetherTruth
 from mjswarm.experiments.embodied import (  # noqa: F401 - the experiment's public names
     BEACON_LABEL,
-    CHILD_SILENCE_S,
     TETHER_MARGIN_M,
     TURN_RESERVE_M,
     EmbodiedConfig,
@@ -226,8 +225,7 @@ class EmbodiedExploration(LoopFunctions):
                      sim.control_dt_s,
                      Tether(i, config.radio_range_m, initial_parents(i, need, first),
                             margin_m=TETHER_MARGIN_M, ticks_per_unit=ticks,
-                            reserve_m=TURN_RESERVE_M,
-                            silence_ticks=round(CHILD_SILENCE_S / sim.control_dt_s))
+                            reserve_m=TURN_RESERVE_M)
                      if tied and i not in world.docked else None)
             for i, (mind, e) in enumerate(zip(self.minds, eps))]
 
