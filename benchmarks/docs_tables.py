@@ -231,6 +231,7 @@ def cli_help() -> str:
 # --- exploration that stays connected ----------------------------------------------
 
 def connected_arena2() -> str:
+    from connected_worlds import outcome
     from mjswarm.arena import load_arena
     from mjswarm.experiments.runs import run_exploration
 
@@ -240,9 +241,7 @@ def connected_arena2() -> str:
                                     (1.5, "biconnected"), (2.5, "biconnected")):
             r = run_exploration(load_arena("arena2"), 4, radio_range_m=range_m,
                                 connectivity=constraint, radio_walls=walls)
-            outcome = "completed" if r.completed else (r.reason or "not completed").split(
-                ":")[0].split(" with ")[0] + ", " + (r.reason or "").split("explored ")[-1]
-            rows.append(["walls" if walls else "open", f"{range_m:g}", constraint, outcome,
+            rows.append(["walls" if walls else "open", f"{range_m:g}", constraint, outcome(r),
                          f"{r.makespan:.1f}" if r.completed else "-", r.messages,
                          r.relay_trips, f"{100 * r.connected_share:.1f} %",
                          f"{100 * r.biconnected_share:.1f} %"])

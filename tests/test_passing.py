@@ -10,12 +10,12 @@ import math
 import pytest
 
 from algorithms.collision import CollisionRule
-from algorithms.exploration.entry import STATION, VertexStations
+from algorithms.exploration.entry import VertexStations
 from algorithms.exploration.passing import PASS_AFTER_S, PASS_STEADY_M, PassRequest
 from algorithms.exploration.explorer import Explorer
 from algorithms.navigation import NavEvent, Navigator, NavigatorState
 from algorithms.navigation.navigator import PASS_MARGIN_M
-from algorithms.robot import Detection, Observation
+from algorithms.robot import Detection
 from mjswarm.arena import load_arena
 from mjswarm.arena.geometry import (LANE_OFFSET_M, SPOKE_INNER_RADIUS_M, VERTEX_CLEAR_RADIUS_M,
                                     vertex_fans)
