@@ -3,7 +3,9 @@ ground-truth check, infeasibility, and the CLI."""
 
 from __future__ import annotations
 
+import functools
 import json
+from types import SimpleNamespace
 
 import pytest
 
@@ -12,6 +14,8 @@ from algorithms.exploration.tether import (BASE, STALL_TIME_UNITS, STALL_UNITS_P
                                            initial_parents)
 from algorithms.exploration.relay import (RELAY, RETURN, TRANSIT, ConnectedExplorer, Flooder,
                                           RelayOffer, RelayWanted, Waits)
+from algorithms.exploration.explorer import Explorer
+from algorithms.exploration.leash import Leash
 from algorithms.robot import Message
 from mjswarm.arena import load_arena
 from mjswarm.cli import main
@@ -183,6 +187,41 @@ def test_a_robot_that_lost_its_parent_to_a_wall_asks_a_still_neighbour():
                Message(Beat((BASE,), 1, True, 0, 0), sender=1)], around)
     assert t.ask(1, (0.004, 0.0), around) == []
     assert t.ask(2, (0.004, 0.0), around, cut={0}) == [Message(Adopt(), to=1)]
+
+
+def test_a_robot_standing_with_its_parent_lost_asks_any_still_neighbour():
+    """Rule 4 while it stands: its only parent, the base, has gone from its ranging (a
+    wall came between), so nobody is fewer hops from the base than its parent; a still
+    neighbour in range that hears the base is asked all the same, and a moving one never."""
+    t = Tether(2, range_m=1.0)
+    around = {1: (0.0, -0.19)}
+    t.hear(1, [Message(Beat((BASE,), 1, False, 0, 0), sender=1)], around)
+    assert t.ask(1, None, around) == []  # robot 1 is under way
+    t.hear(2, [Message(Beat((BASE,), 1, True, 0, 0), sender=1)], around)
+    assert t.ask(2, None, around) == [Message(Adopt(), to=1)] and t.request[2] == BASE
+    # with its parent in its ranging it keeps it: the base is nearest the root
+    t = Tether(2, range_m=1.0)
+    around[BASE] = (-0.8, 0.0)
+    t.hear(1, [Message(Beat((BASE,), 1, True, 0, 0), sender=1)], around)
+    assert t.ask(1, None, around) == []
+
+
+def test_the_retrace_stops_short_of_a_body_in_its_way():
+    """The leash's retrace drives its trail backwards blind of the speed rule: a move that
+    would drive into a robot its ranging shows stays on the trail, and the robot stands;
+    robots beside it (the opposite lane), on its other side and the base's mast are no
+    obstacle."""
+    robot = SimpleNamespace(nav=SimpleNamespace(cal=SimpleNamespace(body_radius_m=0.075)))
+    in_the_way = functools.partial(Explorer._in_the_way, robot)
+    assert in_the_way({1: (-0.17, 0.02)}, -0.1)  # behind, backing up
+    assert not in_the_way({1: (-0.17, 0.02)}, 0.1)  # behind, driving on
+    assert not in_the_way({1: (-0.30, 0.0), 2: (0.0, 0.18), BASE: (-0.1, 0.0)}, -0.1)
+    leash = Leash(Tether(0, range_m=1.0))
+    for move in ((0.1, 0.0), (0.1, 0.5)):
+        leash.check(move, (0.002, 0.0), {BASE: (-0.5, 0.0)}, back=False, at_centre=False)
+    blocked = leash.undo({}, False, lambda vw: (-vw[0], -vw[1]), may=lambda vw: False)
+    assert blocked is None and len(leash._trail) == 2
+    assert leash.undo({}, False, lambda vw: (-vw[0], -vw[1])) == (-0.1, -0.5)
 
 
 def test_a_robot_setting_off_adopts_nobody():

@@ -55,6 +55,7 @@ class Nav:
         self.edge_angles, self.arrived_angle = [ANGLE, math.pi], None
         self.line_filter, self.beacon_frame, self.heading_variance = None, None, 0.0
         self.turns = 0
+        self.cal = SimpleNamespace(body_radius_m=0.075)
 
     def update(self, percept) -> tuple[float, float]:
         return (0.1, 0.0) if self.state is not NavigatorState.AT_VERTEX else (0.0, 0.0)

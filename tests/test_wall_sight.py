@@ -9,8 +9,9 @@ import pytest
 from algorithms.exploration.tether import BASE
 from mjswarm.arena import load_arena
 from mjswarm.arena.builder import arena_world_spec
-from mjswarm.arena.geometry import corridor_walls
-from mjswarm.core.radio import BASE_MAST_M, sight_blocker
+from mjswarm.arena.geometry import (LANE_OFFSET_M, WALL_HEIGHT_M, WALL_THICKNESS_M,
+                                    corridor_walls)
+from mjswarm.core.radio import ANTENNA_HEIGHT_M, BASE_MAST_M, FADE_MARGIN_M, sight_blocker
 from mjswarm.core.simulation import Simulation
 from mjswarm.core.world import Pose2D
 from mjswarm.experiments.minds import make_minds
@@ -75,3 +76,45 @@ def test_the_wall_aware_graph_world_keeps_every_robot_connected():
     open_ = run_connected(world, make_minds("incidence-dfs", 4), 1.5, "connected")
     assert walled.completed and walled.map_correct and walled.connected_share == 1.0
     assert walled.relay_trips > open_.relay_trips and walled.makespan > open_.makespan
+
+
+def clearance(walls, a: np.ndarray, b: np.ndarray) -> float:
+    """Brute force: the least distance (m) between the segment ``a -> b`` (3-D, sampled
+    every millimetre or so) and any wall's box."""
+    points = a + np.linspace(0.0, 1.0, 2000)[:, None] * (b - a)
+    best = np.inf
+    for wall in walls:
+        s, e = np.asarray(wall.start, float), np.asarray(wall.end, float)
+        length = np.hypot(*(e - s))
+        along, normal = (e - s) / length, np.array([-(e - s)[1], (e - s)[0]]) / length
+        rel = points[:, :2] - (s + e) / 2.0
+        dx = np.maximum(np.abs(rel @ along) - length / 2.0, 0.0)
+        dy = np.maximum(np.abs(rel @ normal) - WALL_THICKNESS_M / 2.0, 0.0)
+        dz = np.maximum(points[:, 2] - WALL_HEIGHT_M, 0.0)
+        best = min(best, float(np.sqrt(dx**2 + dy**2 + dz**2).min()))
+    return best
+
+
+def test_a_link_fades_when_its_line_passes_near_a_wall():
+    """The fading blocker (walls grown by ``FADE_MARGIN_M``) against a brute-force
+    clearance, on random pairs of points on the lanes and from the base's mast: a link
+    that fades passes within the margin of a wall (the grown box's corners reach
+    sqrt(3) margins), one that does not fade clears every wall by the margin, and every
+    cut link fades."""
+    spec, rng = load_arena("hex:2x2"), np.random.default_rng(1)
+    walls, where = corridor_walls(spec), {}
+    masts = {BASE: BASE_MAST_M}
+    cut = wall_blocker(walls, where, masts)
+    fades = wall_blocker(walls, where, masts, grow_m=FADE_MARGIN_M)
+    points = on_edges(spec, rng, 300) + rng.uniform(-LANE_OFFSET_M, LANE_OFFSET_M, (300, 2))
+    root, seen = np.array(spec.vertices[spec.root], float), {True: 0, False: 0}
+    for p, q in points.reshape(-1, 2, 2):
+        where.update({0: p, 1: q, BASE: root})
+        for pair, a, b in (([0, 1], (*p, ANTENNA_HEIGHT_M), (*q, ANTENNA_HEIGHT_M)),
+                           ([BASE, 0], (*root, BASE_MAST_M), (*p, ANTENNA_HEIGHT_M))):
+            pair = np.array([pair], object)
+            faded, gap = bool(fades(pair)[0]), clearance(walls, np.array(a), np.array(b))
+            assert not cut(pair)[0] or faded
+            assert (gap <= FADE_MARGIN_M * 3 ** 0.5 + 1e-3) if faded else (gap >= FADE_MARGIN_M - 1e-3)
+            seen[faded and not cut(pair)[0]] += 1
+    assert seen[True] > 5 and seen[False] > 50  # both answers occur

@@ -96,7 +96,7 @@ from algorithms.exploration.modes import (
     Mode,
 )
 from algorithms.exploration.passing import BodyWatch, PassGranted
-from algorithms.exploration.tether import Tether
+from algorithms.exploration.tether import BASE, Tether
 from algorithms.exploration.entry import (
     STATION,
     GIVE_UP_S,
@@ -144,6 +144,10 @@ CREEP_GUARD_M = 0.06
 #: away (``lattice:6x6``, 12 robots, 0.2 m/s, seed 2). The lane leads to the vertex the
 #: robot holds, so nobody is behind it on it.
 WAIT_BACKOFF_M = 0.04
+#: A tethered robot stops short of a robot its ranging shows in its way, this far (m)
+#: beyond touching (two body radii apart): its retrace and its U-turns run blind of the
+#: speed rule (:meth:`Explorer._in_the_way`).
+CLEARANCE_MARGIN_M = 0.03
 
 
 class VertexCall(NamedTuple):
@@ -304,8 +308,12 @@ class Explorer(Controller):
 
     def _on_leash(self, now: int, command: Command, around) -> Command:
         """Rules 3-6 on this tick's command: it stands where the leash (or a wall it met
-        on this leg) forbids its drive, then asks and beats."""
+        on this leg) forbids its drive, or a robot its ranging shows stands in its way
+        (the speed rule governs lanes only, and U-turns and walks back leave them), then
+        asks and beats."""
         moving = command.v_m_s != 0.0
+        if moving and self._in_the_way(around, command.v_m_s):
+            command, moving = Command(messages=command.messages), False
         wanted = self.leash.check(
             (command.v_m_s, command.omega_rad_s) if moving else None,
             (command.v_m_s * self.control_dt_s, 0.0), around, back=self.mode in RETURNING,
@@ -343,11 +351,25 @@ class Explorer(Controller):
         navigator counts these ticks on its odometry (:meth:`~algorithms.navigation.
         Navigator.carried`), so that its motion resumes from where the body is."""
         self.nav.carried(self._percept(observation))
-        move = self.leash.undo(around, self.mode in RETURNING, lambda vw: (-vw[0], -vw[1]))
+        move = self.leash.undo(around, self.mode in RETURNING, lambda vw: (-vw[0], -vw[1]),
+                               may=lambda vw: not self._in_the_way(around, -vw[0]))
         if move is None:
             return self._stand(now, out, around)
         out.append(self.tether.beat(now, True, False, len(self.strategy.map_edges())))
         return Command(*move, messages=tuple(out))
+
+    def _in_the_way(self, around, v_m_s: float) -> bool:
+        """Whether a robot its ranging shows (``around``: position in its own frame, m;
+        the base's mast is no body)
+        stands in the way of a drive at ``v_m_s`` (forwards or backwards): on that side,
+        across less than two body radii, nearer than two radii and ``CLEARANCE_MARGIN_M``.
+        A tethered robot checks this before each drive (:meth:`_on_leash`) and each move
+        of its retrace, which runs blind of the speed rule, often backwards, where its
+        bearing sensor and IR do not look."""
+        reach = 2.0 * (self.nav.cal.body_radius_m or 0.0)
+        return any(j != BASE and x * v_m_s > 0.0 and abs(y) < reach
+                   and math.hypot(x, y) < reach + CLEARANCE_MARGIN_M
+                   for j, (x, y) in around.items())
 
     def _stand(self, now: int, out: list[Message], around) -> Command:
         """Stand still (stopped, done, infeasible, or cut off with no move to undo); a

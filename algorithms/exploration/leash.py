@@ -5,8 +5,9 @@ edge).
 
 The tether (:class:`~algorithms.exploration.tether.Tether`) knows ranges, not walls. A
 robot keeps the moves it made since its parents were last all in radio reach (its
-*trail*); when a wall comes between it and a parent (the link is gone from its radio
-neighbours) it drives them backwards until the link is back, never back into a vertex
+*trail*); when a wall comes between it and a parent (the parent is gone from its
+ranging: on the MuJoCo robots as soon as the link fades, before it is cut) it drives
+them backwards until the link is back, never back into a vertex
 area it has given up (the trail is forgotten when it tells the stations it left one),
 nor off a vertex centre it reached (forgotten there too). The way along its leg in which
 the wall cut a link (+1 on, -1 back) is then closed to it for the rest of the leg, or
@@ -68,12 +69,15 @@ class Leash:
         """The parents a wall cut it from on the way it drives (empty if none)."""
         return self._cut if self._way(back) in self._occluded else ()
 
-    def undo(self, around: Mapping, back: bool, reverse: Callable[[Any], Any]) -> Any:
+    def undo(self, around: Mapping, back: bool, reverse: Callable[[Any], Any],
+             may: Callable[[Any], bool] = lambda move: True) -> Any:
         """A parent's link is gone: this way is closed, and the last move of its trail
-        comes back reversed (``reverse(move)``), or None when nothing is left to undo."""
+        comes back reversed (``reverse(move)``), or None when nothing is left to undo or
+        ``may(move)`` says the move may not be undone now (a body in its way: the move
+        stays on the trail)."""
         self._occluded.add(self._way(back))
         self._cut |= {q for q in self.tether.parents if q not in around}
-        if not self._trail:
+        if not self._trail or not may(self._trail[-1]):
             return None
         return reverse(self._trail.pop())
 

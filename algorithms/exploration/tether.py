@@ -33,8 +33,10 @@ rule below is ours (the papers give none for this combination):
 4. **Adoption, make before break.** A robot without children whose step the leash forbids
    asks one still neighbour (or the base) that would allow the step to adopt it: the
    fewest tree hops from the base first, then the nearest. So does one that sees a still
-   neighbour fewer hops from the base than its parent is (so that relays are released);
-   a robot with children may ask the base itself, which descends from nobody.
+   neighbour fewer hops from the base than its parent is (so that relays are released),
+   and one whose parent has gone from its ranging (a wall came between them: the leash
+   knows ranges, not walls) asks any still neighbour in range; a robot with children
+   may ask the base itself, which descends from nobody.
    The asked robot adds it to its children at once, which makes it hold, and answers
    ``Adopted``. The asker does not move while its request is out and switches parent only
    when the answer comes and the new parent is still in range. While its own request is
@@ -182,7 +184,9 @@ class Tether:
         (None: it wanted to stay) and did not, or could do with a parent nearer the base.
         With two parents it replaces one at a time: the first that forbids the step, else
         the one farthest from the base (in hops). ``cut``: parents whose link the step
-        would lose for another reason than range (a wall, as the robot found)."""
+        would lose for another reason than range (a wall, as the robot found). A parent
+        missing from ``around`` (its link lost, or fading: a wall came between) blocks
+        whatever the step, even staying: any still neighbour in range may replace it."""
         if self.request is not None:
             return []
         deepest = max(self.parents, key=lambda q: self._depth_of(q))
@@ -190,13 +194,13 @@ class Tether:
             if BASE not in self.parents and BASE in self.heard and self._within((0.0, 0.0), around.get(BASE)):
                 return self._request(BASE, tick, deepest)
             return []
-        blocking = [q for q in self.parents if step is not None
-                    and (q in cut or not self._within(step, around.get(q)))]
+        blocking = [q for q in self.parents if q not in around or step is not None
+                    and (q in cut or not self._within(step, around[q]))]
         best = None
         for r, beat in self.heard.items():
             if r in self.parents or not beat.still or r not in around:
                 continue
-            if blocking and self._within(step, around[r]):
+            if blocking and self._within(step or (0.0, 0.0), around[r]):
                 replaced = blocking[0]
             elif (beat.depth < self._depth_of(deepest) and self._within((0.0, 0.0), around[r])
                   and (step is None or deepest in blocking or self._within(step, around[r]))):

@@ -79,6 +79,14 @@ ANTENNA_HEIGHT_M = 0.06
 #: Height (m) of the base station's antenna at the root: above the robots (0.07 m tall),
 #: so that a robot standing on the root does not shadow the others; walls still block.
 BASE_MAST_M = 1.0
+#: A link whose line of sight passes within this (m) of a wall fades: it still carries
+#: messages, but the robots' ranging gets no fix through it (the first Fresnel zone of
+#: a 2.4 GHz link over metres is tens of centimetres wide, and ultra-wideband ranging
+#: through a shadowed zone is unreliable). A robot driving at its top speed (0.2 m/s)
+#: crosses it in a quarter of a second, so one that treats a faded parent as a lost one
+#: (the tether's leash, :mod:`algorithms.exploration.leash`) backs off before the link
+#: itself is cut.
+FADE_MARGIN_M = 0.02
 
 # ------------------------------------------------------------------ immutable payloads
 _ATOM, _SEQUENCE, _FIELDS, _HANDLE = range(4)

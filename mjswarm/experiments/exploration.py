@@ -103,7 +103,8 @@ from algorithms.exploration.tether import (
 from mjswarm.arena import ArenaSpec
 from mjswarm.arena.builder import arena_world_spec
 from mjswarm.core.bearing import BearingSensor
-from mjswarm.core.radio import BASE_MAST_M, Radio, Uplink, sight_blocker
+from mjswarm.arena.geometry import corridor_walls
+from mjswarm.core.radio import BASE_MAST_M, FADE_MARGIN_M, Radio, Uplink, sight_blocker
 from mjswarm.core.simulation import Simulation
 from mjswarm.errors import RunInterrupted
 from mjswarm.experiments.awareness import BeliefSampling, TetherTruth
@@ -134,6 +135,7 @@ from mjswarm.experiments.stations import NearestVertex, StationService
 from mjswarm.worlds.loop import Loop, LoopFunctions, Scene
 from mjswarm.worlds.navigation import calibration, conventions
 from mjswarm.worlds.sparkworld import SparkWorld
+from mjswarm.worlds.wall_sight import wall_blocker
 
 #: Wall seconds between status lines when progress goes to a log, not a terminal.
 STATUS_EVERY_S = 30.0
@@ -197,6 +199,11 @@ class EmbodiedExploration(LoopFunctions):
         if NEED.get(config.connectivity) == 2:
             self.world.docked = {order[0]: root_xy}
             order = order[1:]
+        if tied:  # the leash backs off a fading link before it is cut
+            self.world.fading = wall_blocker(
+                corridor_walls(spec), self.world.positions,
+                dict.fromkeys([*self.world.fixed, *self.world.docked], BASE_MAST_M),
+                grow_m=FADE_MARGIN_M)
         if config.radio_range_m is not None:
             self.world.attach_radio(Radio([*range(k), *self.world.fixed],
                                           range_m=config.radio_range_m,

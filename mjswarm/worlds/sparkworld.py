@@ -35,6 +35,7 @@ from algorithms.batch import BatchCommand, Readings
 from algorithms.exploration.base import BeaconHandle
 from algorithms.robot import NOTHING, Command, Detection, Observation
 from mjswarm.core.bearing import BearingSensor
+from mjswarm.core.radio import Blocker
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.loop import World
 from mjswarm.core.simulation import Simulation
@@ -49,12 +50,17 @@ class SparkWorld(World):
         ranging: robots carry a radio-ranging sensor (as ultra-wideband radios do): the
             range and bearing of every radio neighbour, fixed nodes included, noise-free,
             as ``Observation.detections``.
+        fading: with ranging, the links that fade (a :data:`~mjswarm.core.radio.Blocker`
+            over node pairs, positions read from :attr:`positions`; e.g. those passing
+            within :data:`~mjswarm.core.radio.FADE_MARGIN_M` of a wall): the ranging
+            gets no fix through them, though they still carry messages. None: none fade.
     """
 
     def __init__(self, sim: Simulation, bearing: BearingSensor | None = None,
                  present: np.ndarray | None = None,
                  ranging: bool = False,
-                 beacons: dict | None = None) -> None:
+                 beacons: dict | None = None,
+                 fading: Blocker | None = None) -> None:
         self.sim = sim
         self.n = sim.n
         self.present = np.ones(self.n, bool) if present is None else np.array(present, bool)
@@ -70,6 +76,10 @@ class SparkWorld(World):
         self.fixed = {}
         self.docked = {}
         self.ranging = ranging
+        self.fading = fading
+        #: every radio node's position (m) by address, read when asked: robots' centres,
+        #: fixed nodes' and docked robots' places
+        self.positions = NodePositions(self)
         self._v = [0.0] * self.n  # commands of this tick, as floats (cheaper than numpy items)
         self._w = [0.0] * self.n
         self._version = -1
@@ -202,13 +212,15 @@ class SparkWorld(World):
         self.set_on_air(i, False)
 
     def _ranges(self, i: int, neighbors) -> dict:
-        """Robot ``i``'s ranging of its radio neighbours: range (m) and bearing (rad)."""
-        poses = self.sim.poses()
-        x, y, yaw = poses[i]
+        """Robot ``i``'s ranging of its radio neighbours whose links do not fade: range
+        (m) and bearing (rad)."""
+        x, y, yaw = self.sim.poses()[i]
+        if self.fading is not None and len(neighbors):
+            faded = self.fading(np.array([(i, j) for j in neighbors], object))
+            neighbors = [j for j, fades in zip(neighbors, faded) if not fades]
         out = {}
         for j in neighbors:
-            jx, jy = (self.fixed[j] if j in self.fixed else self.docked[j] if j in self.docked
-                      else poses[j, :2])
+            jx, jy = self.positions[j]
             bearing = math.remainder(math.atan2(jy - y, jx - x) - yaw, 2 * math.pi)
             out[j] = Detection(math.hypot(jx - x, jy - y), bearing)
         return out
@@ -251,3 +263,28 @@ class SparkWorld(World):
         self._v[i] = self._w[i] = 0.0
         self.set_on_air(i, True)
         self.relink()
+
+
+class NodePositions(Mapping):
+    """Every radio node of a :class:`SparkWorld` by address: its position (m) when read
+    (a fixed node's place, a docked robot's, a robot's centre)."""
+
+    def __init__(self, world: SparkWorld) -> None:
+        self._world = world
+
+    def __getitem__(self, j) -> tuple[float, float]:
+        world = self._world
+        if j in world.fixed:
+            return world.fixed[j]
+        if j in world.docked:
+            return world.docked[j]
+        x, y, _ = world.sim.poses()[j]
+        return float(x), float(y)
+
+    def __iter__(self):
+        world = self._world
+        return iter([*world.fixed, *world.docked, *range(world.n)])
+
+    def __len__(self) -> int:
+        world = self._world
+        return len(world.fixed) + len(world.docked) + world.n

@@ -28,13 +28,15 @@ from mjswarm.arena.geometry import WALL_HEIGHT_M, WALL_THICKNESS_M, Wall
 from mjswarm.core.radio import ANTENNA_HEIGHT_M, Blocker
 
 
-def wall_boxes(walls: Sequence[Wall]) -> np.ndarray:
-    """Each wall's footprint as its four sides, ``(walls * 4, 2 ends, 2)`` (m)."""
+def wall_boxes(walls: Sequence[Wall], grow_m: float = 0.0) -> np.ndarray:
+    """Each wall's footprint as its four sides, ``(walls * 4, 2 ends, 2)`` (m), grown by
+    ``grow_m`` on every side."""
     sides = []
     for wall in walls:
         a, b = np.asarray(wall.start, float), np.asarray(wall.end, float)
-        along = b - a
-        normal = np.array([-along[1], along[0]]) / np.hypot(*along) * WALL_THICKNESS_M / 2.0
+        along = (b - a) / np.hypot(*(b - a))
+        a, b = a - grow_m * along, b + grow_m * along
+        normal = np.array([-along[1], along[0]]) * (WALL_THICKNESS_M / 2.0 + grow_m)
         corners = [a + normal, b + normal, b - normal, a - normal]
         sides += [(corners[k], corners[(k + 1) % 4]) for k in range(4)]
     return np.array(sides, float).reshape(-1, 2, 2)
@@ -56,12 +58,15 @@ def _crossings(a: np.ndarray, b: np.ndarray, sides: np.ndarray) -> np.ndarray:
 
 
 def wall_blocker(walls: Sequence[Wall], positions: Mapping[Hashable, Sequence[float]],
-                 masts: Mapping[Hashable, float]) -> Blocker:
+                 masts: Mapping[Hashable, float], grow_m: float = 0.0) -> Blocker:
     """The radio's :data:`~mjswarm.core.radio.Blocker` for points among ``walls``: for each
     pair, whether the line between the antennas passes through a wall (module
     docstring). ``positions`` (m, read at call time) by node; ``masts``: the antenna
-    height (m) of each fixed node (every other node is a robot)."""
-    sides = wall_boxes(walls)
+    height (m) of each fixed node (every other node is a robot). With ``grow_m`` (m), the
+    walls are grown by that much on every side and in height: the links that pass within
+    about ``grow_m`` of a wall (a fading link, :data:`~mjswarm.core.radio.FADE_MARGIN_M`)."""
+    sides = wall_boxes(walls, grow_m)
+    top_m = WALL_HEIGHT_M + grow_m
 
     def blocked(pairs: np.ndarray) -> np.ndarray:
         pairs = np.asarray(pairs, object).reshape(-1, 2)
@@ -73,7 +78,7 @@ def wall_blocker(walls: Sequence[Wall], positions: Mapping[Hashable, Sequence[fl
         high_b = np.array([masts.get(j, ANTENNA_HEIGHT_M) for _, j in pairs])
         t = _crossings(a, b, sides)  # (pairs, sides)
         height = high_a[:, None] + t * (high_b - high_a)[:, None]  # the line over each crossing
-        cut = np.any(height <= WALL_HEIGHT_M, axis=1)  # NaN (no crossing) compares False
+        cut = np.any(height <= top_m, axis=1)  # NaN (no crossing) compares False
         both_fixed = np.array([i in masts and j in masts for i, j in pairs], bool)
         return cut & ~both_fixed
 
