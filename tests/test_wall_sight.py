@@ -118,3 +118,19 @@ def test_a_link_fades_when_its_line_passes_near_a_wall():
             assert (gap <= FADE_MARGIN_M * 3 ** 0.5 + 1e-3) if faded else (gap >= FADE_MARGIN_M - 1e-3)
             seen[faded and not cut(pair)[0]] += 1
     assert seen[True] > 5 and seen[False] > 50  # both answers occur
+
+
+def test_ground_truth_counts_the_links_walls_block():
+    """The graph world's ground truth asks the walls too: an unconstrained team on arena2
+    is cut off from the base in more ticks when walls block links than by range alone,
+    and a connected team with walls never is (its links fade a step before a wall)."""
+    spec = load_arena("arena2")
+    world = GraphWorld(spec.graph(), spec.root)
+
+    def cut(connectivity: str, walls) -> int:
+        return run_connected(world, make_minds("incidence-dfs", 4), 1.5, connectivity,
+                             walls=walls, max_time=60).cut_ticks
+
+    walls = corridor_walls(spec)
+    assert cut("none", walls) > cut("none", None) > 0
+    assert cut("connected", walls) == 0

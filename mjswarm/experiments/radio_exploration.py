@@ -64,6 +64,7 @@ from mjswarm.experiments.results import ExplorationResult, Paths
 from mjswarm.worlds.graphworld import GraphWorld
 from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.radiograph import ANSWER, TICKS_PER_UNIT, RadioGraphWorld
+from mjswarm.worlds.wall_sight import wall_blocker
 
 CONNECTIVITY = ("none", "connected", "biconnected")
 #: Parents each robot keeps under each constraint (rule 1 of the tether).
@@ -131,6 +132,11 @@ class ConnectedExploration(LoopFunctions):
         self.infeasible: int | None = None
         self.ticks = self.cut = self.fragile = 0
         self._base_xy = world.pos[root][None]
+        #: with walls, ground truth's line-of-sight test: nodes by index, the base last
+        self._where: dict = {}
+        self._blocked = None if world.walls is None else wall_blocker(
+            world.walls, self._where, {world.n: world.mast_m,
+                                       **dict.fromkeys(world.docked, world.mast_m)})
 
     def after_step(self, loop: Loop) -> None:
         w = self.world
@@ -153,11 +159,16 @@ class ConnectedExploration(LoopFunctions):
         return self.paths.declared is not None or self.infeasible is not None
 
     def _radio_graph(self, xy: np.ndarray) -> nx.Graph:
-        """Ground truth: the radio graph of the robots and the base (the last node)."""
+        """Ground truth: the radio graph of the robots and the base (the last node): the
+        pairs within range, less those the walls block."""
         g = nx.Graph()
         g.add_nodes_from(range(len(xy)))
         d2 = ((xy[:, None] - xy[None]) ** 2).sum(axis=-1)
-        g.add_edges_from(zip(*np.nonzero(np.triu(d2 <= self.world.range_m**2, 1))))
+        pairs = np.transpose(np.nonzero(np.triu(d2 <= self.world.range_m**2, 1)))
+        if self._blocked is not None and len(pairs):
+            self._where.update(enumerate(xy))
+            pairs = pairs[~self._blocked(pairs)]
+        g.add_edges_from(map(tuple, pairs))
         return g
 
     def result(self, loop: Loop) -> ConnectedExplorationResult:

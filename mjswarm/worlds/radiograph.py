@@ -82,6 +82,9 @@ class RadioGraphWorld(World):
                                  graph.pos[u][1] - graph.pos[v][1])
                         for v, u in graph.duration}
         self._share = {e: 1.0 / (d * TICKS_PER_UNIT) for e, d in graph.duration.items()}
+        #: the longest step a robot takes in a tick (m)
+        self.step_m = max((self._share[e] * math.hypot(*self._vector[e]) for e in self._share),
+                          default=0.0)
         self.uplinks = {}
         self.reset(0)
 
@@ -113,8 +116,13 @@ class RadioGraphWorld(World):
         self._robot_out: list = []
         self._node_out: list = []
         self.radio = None
-        blocked = None if self.walls is None else wall_blocker(
-            self.walls, self._xy, dict.fromkeys([*self.fixed, *self.docked], self.mast_m))
+        masts = dict.fromkeys([*self.fixed, *self.docked], self.mast_m)
+        blocked = self.fading = None
+        if self.walls is not None:
+            blocked = wall_blocker(self.walls, self._xy, masts)
+            #: the links that fade (their line passes within a step of a wall:
+            #: :meth:`_around`); None in the open model
+            self.fading = wall_blocker(self.walls, self._xy, masts, grow_m=self.step_m)
         self.attach_radio(Radio([*range(n_robots), *self.fixed], range_m=self.range_m,
                                 blocked=blocked))
 
@@ -227,6 +235,15 @@ class RadioGraphWorld(World):
         self.xy[i] = xy
 
     def _around(self, i: int) -> dict:
-        """Robot ``i``'s range-and-bearing sensing of its radio neighbours (m, relative)."""
+        """Robot ``i``'s range-and-bearing sensing of its radio neighbours (m, relative).
+        With walls, a neighbour whose link fades (its line passes within one step,
+        :attr:`step_m`, of a wall) gets no fix, as on the MuJoCo robots
+        (:data:`~mjswarm.core.radio.FADE_MARGIN_M`): a point that treats it as lost
+        backs off before its next step could take the link (the line at a wall moves
+        less than the robot does)."""
         (x, y), xy = self._xy[i], self._xy
-        return {r: (xy[r][0] - x, xy[r][1] - y) for r in self.radio.neighbors(i)}
+        neighbours = self.radio.neighbors(i)
+        if self.fading is not None and len(neighbours):
+            faded = self.fading(np.array([(i, r) for r in neighbours], object))
+            neighbours = [r for r, fades in zip(neighbours, faded) if not fades]
+        return {r: (xy[r][0] - x, xy[r][1] - y) for r in neighbours}
