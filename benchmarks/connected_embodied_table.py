@@ -56,8 +56,8 @@ def run_case(case: tuple) -> str:
     wall = time.perf_counter() - start
     if r.completed:
         outcome = f"completed, {r.makespan} / {r.total_traversals}"
-    elif r.infeasible:
-        outcome = "infeasible: " + r.reason.split(": ")[1]
+    elif r.reason is not None:  # rule 5's verdict: infeasible, or stalled
+        outcome = r.reason.split(" with ")[0] + ": " + r.reason.split(": ")[1]
     else:
         outcome = r.ended_because
     fragile = r.fragile_ticks if constraint == "biconnected" else "-"

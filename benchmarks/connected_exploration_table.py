@@ -53,7 +53,9 @@ def _span(r: dict) -> str:
     """The makespan (time units), or the verdict."""
     if r["completed"]:
         return f"{r['makespan']:g}"
-    return "infeasible (" + r["reason"].split(": ")[1] + ")" if r["infeasible"] else "time limit"
+    if r["reason"] is None:
+        return "time limit"
+    return r["reason"].split(" with ")[0] + " (" + r["reason"].split(": ")[1] + ")"
 
 
 if __name__ == "__main__":

@@ -34,12 +34,14 @@ SPEED_M_S = 0.1
 
 
 def outcome(r) -> str:
-    """Completed, or the verdict with the share of the edges explored."""
+    """Completed, or the verdict (infeasible, stalled) with the share of the edges
+    explored and the robots the arena needs."""
     if r.completed:
         return "completed"
     reason = getattr(r, "reason", None) or getattr(r, "ended_because", "")
     if "explored " in reason:
-        return f"{reason.split(' with ')[0]}, {reason.split('explored ')[1]}"
+        explored = reason.split("explored ")[1].split(";")[0]
+        return f"{reason.split(' with ')[0]}, {explored}, needs {r.robots_needed}"
     return reason or "not completed"
 
 

@@ -23,6 +23,7 @@ from mjswarm.errors import MjswarmError
 from mjswarm.experiments.minds import make_minds
 from mjswarm.worlds.graphworld import GraphWorld
 from mjswarm.experiments.radio_exploration import run_connected
+from mjswarm.experiments.reach import robots_needed
 from mjswarm.worlds.radiograph import TICKS_PER_UNIT
 
 
@@ -48,16 +49,22 @@ def test_the_constraint_always_holds_and_every_run_ends_by_a_verdict(arena, robo
     """Ground truth (networkx, every tick): with ``connected`` every robot always has a
     route to the base, with ``biconnected`` the radio graph with the base is biconnected;
     the run ends by completion with the true map or by a declared stall, never at the
-    time limit."""
+    time limit. The stall is infeasible exactly when the team is smaller than the arena
+    needs (:func:`~mjswarm.experiments.reach.robots_needed`), and a team that completes
+    is never smaller: the bound holds."""
     result, world = run(arena, robots, range_m, connectivity)
     assert result.cut_ticks == 0 and result.connected_share == 1.0
     if connectivity == "biconnected":
         assert result.fragile_ticks == 0 and result.biconnected_share == 1.0
-    assert result.completed != result.infeasible
+    assert result.completed != (result.infeasible or result.stalled)
     if result.completed:
         assert result.map_correct
+        assert robots >= robots_needed(world.pos, list(world.edges), world.root, range_m,
+                                       connectivity=connectivity)
     else:
-        assert result.reason.startswith(f"infeasible with {robots} robots at range {range_m:g} m")
+        kind = "infeasible" if result.infeasible else "stalled"
+        assert result.reason.startswith(f"{kind} with {robots} robots at range {range_m:g} m")
+        assert result.infeasible == (robots < result.robots_needed)
     assert result.messages > 0
 
 
@@ -89,7 +96,8 @@ def test_too_few_robots_for_the_range_is_reported_infeasible_before_the_time_lim
     result, world = run("lattice:5x5", 2, 0.7)
     assert result.infeasible and not result.completed
     assert result.reason.startswith("infeasible with 2 robots at range 0.7 m: explored ")
-    assert result.reason.endswith(" of 40 edges")
+    assert result.reason.endswith(" of 40 edges; every edge needs at least 5")
+    assert result.robots_needed == 5  # lattice:5x5's far corner: 2.4 m of corridor at 0.7 m
 
 
 @pytest.mark.parametrize("robots,completes", [(2, False), (4, True)])
@@ -108,8 +116,8 @@ def test_a_corridor_chain_is_not_anchored_next_to_the_base():
     own choice adopt, so no relay is made next to the base and the chain reaches 6 of the
     7 edges (5 when a robot paused near the root could be adopted)."""
     result, _ = run("lattice:1x8", 5, 1.0)
-    assert result.infeasible and result.cut_ticks == 0
-    assert "explored 6 of 7 edges" in result.reason
+    assert result.stalled and not result.infeasible and result.cut_ticks == 0
+    assert "explored 6 of 7 edges" in result.reason and result.robots_needed == 5
 
 
 def test_a_robot_paused_between_moves_does_not_say_it_stands_still():
@@ -396,13 +404,15 @@ def test_embodied_biconnected_team_completes_with_its_first_robot_docked():
 def test_embodied_biconnected_team_reports_when_its_docked_robot_fails():
     """R1, docked at the base, fails at 5 s: the two explorers have lost a parent and
     cannot be each other's second parent (rule 1 orders parents), so they stand, and the
-    team declares itself infeasible (rule 5, at 345 s) well before the time limit
-    (3600 s)."""
+    team declares a stall (rule 5, at 345 s) well before the time limit (3600 s). The
+    bound does not call it infeasible: two robots still work, as many as the arena's
+    chain (one robot at 3 m) and a dock need, though the dock was the one that failed."""
     from mjswarm.experiments.faults import RobotFailure
 
     result = embodied("arena1", 3, 3.0, seed=0, connectivity="biconnected", speed_m_s=0.1,
                       faults=[RobotFailure(0, 5.0)])
-    assert result.infeasible and result.ended_because.startswith("infeasible with 3 robots")
+    assert result.stalled and result.ended_because.startswith("stalled with 3 robots")
+    assert "2 still working" in result.ended_because and result.robots_needed == 2
     assert result.sim_time_s < 1000.0 and result.cut_ticks == 0
     assert result.stopped_robots[0]["robot"] == 1 and result.collisions == 0
 
@@ -410,10 +420,11 @@ def test_embodied_biconnected_team_reports_when_its_docked_robot_fails():
 @pytest.mark.slow
 def test_embodied_too_short_a_range_ends_in_a_verdict():
     """1.5 m: walls cut links the leash cannot foresee; the robots back out of each cut
-    (a few ticks), and the team declares itself infeasible instead of running on."""
+    (a few ticks), and the team declares a stall instead of running on; two robots are
+    as many as the arena's longest chain at 1.5 m, so the verdict is a stall."""
     result = embodied("arena1", 2, 1.5, speed_m_s=0.1)
-    assert result.infeasible and not result.completed
-    assert result.reason.startswith("infeasible with 2 robots at range 1.5 m: explored ")
+    assert result.stalled and not result.completed and result.robots_needed == 2
+    assert result.reason.startswith("stalled with 2 robots at range 1.5 m: explored ")
     assert result.collisions == 0
     assert result.connected_share > 0.999
 

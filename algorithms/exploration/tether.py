@@ -43,14 +43,17 @@ rule below is ours (the papers give none for this combination):
    out a robot refuses requests, so simultaneous requests cannot close a cycle. A robot
    without children has no descendants and the base is nobody's, so no other request can
    close one either.
-5. **Stall, and infeasibility.** Every beat carries the latest time at which its sender
+5. **Stall.** Every beat carries the latest time at which its sender
    knows that an exploring robot reached a vertex (so that its strategy decided anew), and
    the most edges it knows any robot's map to hold. The team is connected, so both reach
    everybody. A robot that knows of no such arrival for ``STALL_TIME_UNITS`` plus
-   ``STALL_UNITS_PER_EDGE`` time units per known edge declares the exploration infeasible:
-   a relay's round trip (rule 6, :mod:`algorithms.exploration.relay`) crosses each known
-   edge at most twice each way, so past that time nobody is on the way to unblock anybody,
-   no beacon changes, and no strategy changes its mind.
+   ``STALL_UNITS_PER_EDGE`` time units per known edge declares a stall (the event
+   :class:`~algorithms.exploration.events.Infeasible`, the team's own verdict): a relay's
+   round trip (rule 6, :mod:`algorithms.exploration.relay`) crosses each known edge at
+   most twice each way, so past that time nobody is on the way to unblock anybody, no
+   beacon changes, and no strategy changes its mind. It is a stall of this team, not a
+   proof about the arena: the experiments weigh it against the robots the arena needs
+   (:mod:`mjswarm.experiments.reach`: infeasible only with fewer).
 
 This module is the robot side: pure Python, no simulator.
 :mod:`mjswarm.experiments.radio_exploration`

@@ -194,7 +194,8 @@ def register(subparsers) -> None:
                              "(the first robot docks at the base as its partner and does "
                              "not explore; needs 2 or more robots). "
                              "Needs --radio-range. A team that cannot go on says so "
-                             "(infeasible) and stops. Robots stuck at the end of their "
+                             "(infeasible: fewer robots than the arena needs; else "
+                             "stalled) and stops. Robots stuck at the end of their "
                              "leash call relays, in both worlds")
     parser.add_argument("--radio-range", default=None, metavar="M",
                         action=number(above=0, most=MAX_RANGE_M,
@@ -363,9 +364,15 @@ def summary(result: dict) -> str:
         why = result.get("reason") or result.get("ended_because") or "max time"
         lines = [head, f"not completed ({why}): no robot declared completion", traversals]
         if result.get("infeasible"):
-            lines.append("infeasible is the tether's stall verdict (rule 5): no robot reached "
-                         "a new edge for a while; a larger team or a longer radio range may "
-                         "complete the arena")
+            lines.append(f"infeasible: the team stalled (the tether's rule 5), and a robot "
+                         f"at the farthest point of an edge needs a chain of "
+                         f"{result['robots_needed']} robots to the base at this range; add "
+                         f"robots or range")
+        elif result.get("stalled"):
+            lines.append(f"stalled: no robot reached a new vertex for a while (the "
+                         f"tether's rule 5), though {result['robots_needed']} robots could "
+                         f"reach every edge at this range: the team did not find the way "
+                         f"(more robots or range may help)")
     if "radio_range_m" in result:
         lines.append(
             f"radio {result['radio_range_m']:g} m"

@@ -135,8 +135,12 @@ class EmbodiedResult(ExplorationResult):
     fragile_ticks: int = 0
     connected_share: float | None = None
     biconnected_share: float | None = None
-    #: whether the robots declared the exploration infeasible (rule 5 of the tether)
+    #: the robots declared a stall (rule 5 of the tether): ``infeasible`` with fewer
+    #: robots than the arena needs (``robots_needed``,
+    #: :func:`~mjswarm.experiments.reach.robots_needed`), else ``stalled``
     infeasible: bool = False
+    stalled: bool = False
+    robots_needed: int | None = None
     reason: str | None = None
     #: relay missions the robots set out on (rule 6 of :mod:`algorithms.exploration.relay`)
     relay_trips: int = 0

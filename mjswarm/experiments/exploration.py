@@ -129,7 +129,8 @@ from mjswarm.experiments.metrics import (
     team_cut_off,
 )
 from mjswarm.experiments.minds import make_minds, strategy_name
-from mjswarm.experiments.radio_exploration import NEED, infeasible_reason
+from mjswarm.experiments.radio_exploration import NEED, stall_verdict
+from mjswarm.experiments.reach import robots_needed
 from mjswarm.experiments.results import outcome
 from mjswarm.experiments.stations import NearestVertex, StationService
 from mjswarm.worlds.loop import Loop, LoopFunctions, Scene
@@ -158,6 +159,7 @@ class EmbodiedExploration(LoopFunctions):
         k = len(minds)
         order = check_config(spec, k, config)
         self.spec, self.minds, self.config, self.seed = spec, minds, config, seed
+        self._needed: int | None = None  # robots_needed, once asked
         terminal = progress and sys.stderr.isatty()
         if terminal:  # a transient line, cleared when the world is built
             print(f"explore: building {spec.name} with {k} robot(s) ...", end="\r",
@@ -251,7 +253,9 @@ class EmbodiedExploration(LoopFunctions):
                                    self.stations, self.roster)
         self.metrics = ExplorationMetrics(
             world, self.roster, nearest, spec.root, None if tied else stall_timeout(spec, config),
-            lambda paths: infeasible_reason(k, config.radio_range_m, paths, len(spec.edges)))
+            lambda paths: stall_verdict(k, config.radio_range_m, paths, len(spec.edges),
+                                        self.robots_needed(),
+                                        k - len(self.metrics.stopped)))
         self.faults = Faults(world, config.faults, switched_off=(
             self.stations.switched_off, self.launching.switched_off, self.metrics.switched_off))
         self.tether_truth = TetherTruth(world) if tied else None
@@ -318,6 +322,25 @@ class EmbodiedExploration(LoopFunctions):
                 f"{', 1 docked at the base' if world.docked else ''}, "
                 f"{len(self.metrics.stopped)} stopped")
 
+    def robots_needed(self) -> int:
+        """The fewest robots that could reach every edge under the run's constraint and
+        radio (:func:`~mjswarm.experiments.reach.robots_needed`; computed once)."""
+        if self._needed is None:
+            spec, config = self.spec, self.config
+            self._needed = robots_needed(spec.vertices, spec.edges, spec.root,
+                                         config.radio_range_m, corridor_walls(spec),
+                                         BASE_MAST_M, config.connectivity)
+        return self._needed
+
+    def _stall(self) -> dict:
+        """The result's fields on rule 5's verdict (:func:`stall_verdict`)."""
+        m = self.metrics
+        if not m.infeasible:
+            return {}
+        infeasible, reason = m.stall_verdict(m.paths)
+        return {"infeasible": infeasible, "stalled": not infeasible, "reason": reason,
+                "robots_needed": self.robots_needed()}
+
     def closed_items(self) -> list[tuple[str, tuple[int, float]]]:
         """The closed vertices (:attr:`StationService.closed`), in the order they closed."""
         return sorted(self.stations.closed.items(), key=lambda item: item[1][1])
@@ -377,9 +400,8 @@ class EmbodiedExploration(LoopFunctions):
             fragile_ticks=0 if truth is None else truth.fragile_ticks,
             connected_share=connected,
             biconnected_share=biconnected,
-            infeasible=m.infeasible,
+            **self._stall(),
             relay_trips=m.relay_trips,
-            reason=m.infeasible_reason(m.paths) if m.infeasible else None,
             ended_because=ended,
             closed_vertices=[{"vertex": v, "robot": r + 1, "at_s": round(t, 2)}
                              for v, (r, t) in self.closed_items()],

@@ -70,14 +70,15 @@ class ExplorationMetrics(LoopFunctions):
         root: where every path starts.
         stall_timeout_s: end the run when no robot reached a vertex for this long (None:
             never; the tethered robots judge stalls themselves).
-        infeasible_reason: ``infeasible_reason(paths)``, the verdict's text.
+        stall_verdict: ``stall_verdict(paths)``, the verdict on rule 5's stall: whether
+            it is infeasible, and its text.
     """
 
     def __init__(self, world, roster: Roster, nearest: Callable, root: str,
-                 stall_timeout_s: float | None, infeasible_reason: Callable) -> None:
+                 stall_timeout_s: float | None, stall_verdict: Callable) -> None:
         self.world, self.roster, self.nearest = world, roster, nearest
         self.stall_timeout_s = stall_timeout_s
-        self.infeasible_reason = infeasible_reason
+        self.stall_verdict = stall_verdict
         #: the paths and the declaration; of two declarations in one tick the last counts
         self.record = Paths(world.n, root, keep="last")
         self.beacon_vertex: dict[str, str] = {}
@@ -167,7 +168,7 @@ class ExplorationMetrics(LoopFunctions):
         if self.declared is not None:
             self.ended_because = "completed"
         elif self.infeasible:
-            self.ended_because = self.infeasible_reason(self.paths)
+            self.ended_because = self.stall_verdict(self.paths)[1]
         elif self.roster.count_done >= self.world.n:
             self.ended_because = "all robots stopped"
         elif (self.stall_timeout_s is not None

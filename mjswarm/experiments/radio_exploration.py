@@ -31,7 +31,9 @@ descending index (the order of Nagavarapu et al.'s Fig. 9 run):
    which the graph is not biconnected (one robot failing would cut someone off).
 
 The run ends when a robot declares completion, when a robot declares a stall (rule 5 of
-the tether: the result is ``infeasible``, with the explored share of the true edges), or
+the tether: the result is ``infeasible`` if the team has fewer robots than the arena
+needs, :mod:`mjswarm.experiments.reach`, else ``stalled``; with the explored share of the
+true edges), or
 at ``max_time``.
 """
 
@@ -60,6 +62,7 @@ from mjswarm.core.radio import BASE_MAST_M
 from mjswarm.errors import MjswarmError
 from mjswarm.experiments.graph_exploration import default_max_time
 from mjswarm.experiments.minds import strategy_name
+from mjswarm.experiments.reach import robots_needed
 from mjswarm.experiments.results import ExplorationResult, Paths
 from mjswarm.worlds.graphworld import GraphWorld
 from mjswarm.worlds.loop import Loop, LoopFunctions
@@ -71,12 +74,23 @@ CONNECTIVITY = ("none", "connected", "biconnected")
 NEED = {"connected": 1, "biconnected": 2}
 
 
-def infeasible_reason(robots: int, range_m: float, paths: list[list], edges: int) -> str:
-    """The verdict of a team that declared a stall (rule 5 of the tether), with the share
-    of the ``edges`` true edges its ``paths`` (vertex sequences, one per robot) covered."""
+def stall_verdict(robots: int, range_m: float, paths: list[list], edges: int,
+                  needed: int, working: int | None = None) -> tuple[bool, str]:
+    """The verdict on a team that declared a stall (rule 5 of the tether): whether it is
+    infeasible (fewer ``working`` robots, by default all ``robots``, than the arena
+    ``needed``, :func:`~mjswarm.experiments.reach.robots_needed`: no strategy could
+    complete it) or the team's stall, and its text, with the share of the ``edges`` true
+    edges its ``paths`` (vertex sequences, one per robot) covered."""
     explored = {tuple(sorted(e)) for p in paths for e in zip(p, p[1:])}
-    return (f"infeasible with {robots} robots at range {range_m:g} m: explored "
-            f"{len(explored)} of {edges} edges")
+    working = robots if working is None else working
+    infeasible = working < needed
+    text = (f"{'infeasible' if infeasible else 'stalled'} with {robots} robots at range "
+            f"{range_m:g} m: explored {len(explored)} of {edges} edges; ")
+    if working < robots:
+        text += f"{working} still working; "
+    if infeasible:
+        return True, text + f"every edge needs at least {needed}"
+    return False, text + f"{needed} could reach every edge"
 
 
 def need_robots(connectivity: str, robots: int) -> None:
@@ -103,8 +117,12 @@ class ConnectedExplorationResult(ExplorationResult):
         fragile_ticks: ticks in which it was not.
         relay_trips: relay missions the robots set out on (rule 6 of
             :mod:`algorithms.exploration.relay`).
-        infeasible: whether the team declared that it cannot go on.
-        reason: why, with the explored share of the true edges; None otherwise.
+        infeasible: whether the team declared a stall (rule 5) with fewer robots than
+            the arena needs (:func:`~mjswarm.experiments.reach.robots_needed`).
+        stalled: whether it declared a stall with as many or more.
+        robots_needed: after a stall, the fewest robots that could reach every edge.
+        reason: the verdict on a stall, with the explored share of the true edges; None
+            otherwise.
     """
 
     connectivity: str = "none"
@@ -116,6 +134,8 @@ class ConnectedExplorationResult(ExplorationResult):
     fragile_ticks: int = 0
     relay_trips: int = 0
     infeasible: bool = False
+    stalled: bool = False
+    robots_needed: int | None = None
     reason: str | None = None
 
 
@@ -178,8 +198,10 @@ class ConnectedExploration(LoopFunctions):
         fields = self.paths.outcome(self.strategy, None if declared is None else declared[0],
                                     dropped, g.edges, arena=self.arena, root=g.root,
                                     edge_time=g.edge_time, seed=self.seed)
-        reason = None if self.infeasible is None else infeasible_reason(
-            w.n, w.range_m, paths, len(g.edges))
+        needed = None if self.infeasible is None else robots_needed(
+            g.pos, list(g.edges), g.root, w.range_m, w.walls, w.mast_m, self.connectivity)
+        infeasible, reason = (False, None) if self.infeasible is None else stall_verdict(
+            w.n, w.range_m, paths, len(g.edges), needed)
         ticks = max(self.ticks, 1)
         return ConnectedExplorationResult(
             **fields, connectivity=self.connectivity, radio_range_m=w.range_m,
@@ -188,7 +210,8 @@ class ConnectedExploration(LoopFunctions):
             fragile_ticks=self.fragile,
             relay_trips=sum(c.telemetry().get("relay_trips", 0)
                             for c in loop.controllers.values()),
-            infeasible=self.infeasible is not None, reason=reason)
+            infeasible=infeasible, stalled=self.infeasible is not None and not infeasible,
+            robots_needed=needed, reason=reason)
 
 
 def connected_controllers(minds: Sequence[Strategy], radio_range_m: float,
