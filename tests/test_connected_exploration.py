@@ -161,19 +161,50 @@ def test_a_robot_held_by_the_world_as_long_as_a_stuck_one_offers_itself():
     assert offers(robot.hear(waits.recruit + 2, [_wanted(3)], {})) == []
 
 
-def test_a_relay_held_on_its_way_relays_from_there_but_not_before_it_set_off():
-    """A relay held on its edge as long as a stuck one becomes a relay there; held on the
-    centre it waits to leave (under way only once the world asked its direction)."""
-    robot = ConnectedExplorer(0, make_minds("incidence-dfs", 1, None)[0], Tether(0, range_m=1.0))
-    robot.mode, robot.plan = TRANSIT, [("go", 1.0)]
-    recruit = robot._waits.recruit
-    for tick in range(1, recruit + 2):
-        robot.after(tick, None, False, {}, held=True)
-    assert robot.mode == TRANSIT  # never under way
-    robot.direction(0.4)
-    for tick in range(recruit + 2, 2 * recruit + 3):
-        robot.after(tick, None, False, {}, held=True)
-    assert robot.mode == RELAY
+def test_a_relay_held_on_its_way_relays_from_there():
+    """A relay held on its way as long as a stuck one becomes a relay there, on its edge
+    or on a vertex centre where it waits for the next vertex; held for less, it goes on."""
+    for under_way in (False, True):
+        robot = ConnectedExplorer(0, make_minds("incidence-dfs", 1, None)[0],
+                                  Tether(0, range_m=1.0))
+        robot.mode, robot.plan = TRANSIT, [("go", 1.0)]
+        if under_way:
+            robot.direction(0.4)
+        recruit = robot._waits.recruit
+        for tick in range(1, recruit):
+            robot.after(tick, None, False, {}, held=True)
+        assert robot.mode == TRANSIT
+        robot.after(recruit, None, False, {}, held=True)
+        assert robot.mode == RELAY
+
+
+def test_a_requester_awaits_the_relay_it_accepted():
+    """Rule 6: once it accepted an offer, a requester stuck at its leash asks nobody else
+    and does not retreat while its relay may still be on its way (the offer's timeout and
+    JOURNEY_UNITS_PER_LEG per leg of its route); then it asks again, and retreats as
+    before. Moving on ends the wait."""
+    from algorithms.exploration.relay import EXPLORE, JOURNEY_UNITS_PER_LEG, RETREAT, Leg
+
+    robot = ConnectedExplorer(1, make_minds("incidence-dfs", 1, None)[0], Tether(1, range_m=1.0))
+    robot.leg, waits = Leg("b0", 0.0), robot._waits
+    wanted = lambda out: [m.payload for m in out if isinstance(m.payload, RelayWanted)]
+    tick, asked = 0, []
+    while not asked:
+        tick += 1
+        asked = wanted(robot.after(tick, (0.1, 0.0), False, {}))
+    tick += 1
+    robot.hear(tick, [Message(RelayOffer(1, asked[0].serial, 0), sender=0)], {})
+    deadline = tick + waits.offer + round(JOURNEY_UNITS_PER_LEG * robot.tether.ticks_per_unit)
+    while tick < deadline - 1:
+        tick += 1
+        assert wanted(robot.after(tick, (0.1, 0.0), False, {})) == []
+        assert robot.mode == EXPLORE
+    tick += 1
+    assert wanted(robot.after(tick, (0.1, 0.0), False, {}))  # its relay did not come
+    while robot.mode == EXPLORE:
+        tick += 1
+        robot.after(tick, (0.1, 0.0), False, {})
+    assert robot.mode == RETREAT and tick - deadline <= waits.retreat
 
 
 # ---------------------------------------------------------------------------- the tether

@@ -102,7 +102,7 @@ class Mind:
 class Tied:
     """A tether and its connected exploration, as far as the explorer asks them."""
 
-    me, parents, relay_trips, consulted, stops_part_way = 0, (), 0, True, False
+    me, parents, relay_trips, consulted, stops_part_way, mode = 0, (), 0, True, False, "explore"
 
     def __init__(self, mind: Mind) -> None:
         self.mind, self.children, self.sense, self.stall = mind, set(), 1, False
@@ -281,6 +281,17 @@ def test_a_relay_mission_from_a_centre_withdraws_and_decides_anew():
     held.step(EntryGranted(True, ANGLE))
     held.tie.relay_trips = 1
     assert held.step() is Mode.IDLE and (Mode.WITHDRAWN, Mode.DECIDING) in held.moves
+
+
+def test_a_relay_held_on_a_centre_on_its_way_withdraws_and_relays_there():
+    """On its way, a relay that waits on a vertex centre for the next vertex as long as
+    rule 6 lets a held relay wait becomes a relay there: it withdraws its request and
+    stands (its strategy is not asked)."""
+    r = asking(IDLE, tied=True)
+    assert r.step() is Mode.ASKING and Withdraw() not in r.sent
+    r.tie.mode = "relay"
+    assert r.step() is Mode.IDLE and Withdraw() in r.sent
+    assert (Mode.ASKING, Mode.DECIDING) in r.moves
 
 
 def test_walking_back_from_the_area_it_leaves():

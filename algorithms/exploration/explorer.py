@@ -84,7 +84,7 @@ from algorithms.exploration.events import (
     Stopped,
     vertex_called,
 )
-from algorithms.exploration.relay import ConnectedExplorer
+from algorithms.exploration.relay import RELAY, ConnectedExplorer
 from algorithms.exploration.leash import Leash
 from algorithms.exploration.modes import (
     HOLDS_BEHIND,
@@ -305,6 +305,8 @@ class Explorer(Controller):
             self._trips = self.connected.relay_trips
             self._events.append(RelayTrip())
             self._set_out(observation, out)
+        elif self.mode in WAITING and self.connected.mode == RELAY:
+            self._set_out(observation, out)  # held on its way on a centre: it relays here
 
     def _on_leash(self, now: int, command: Command, around) -> Command:
         """Rules 3-6 on this tick's command: it stands where the leash (or a wall it met

@@ -16,6 +16,12 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   one of two stuck robots always serves the other.
 * **Accept.** The requester takes the first offer (the lowest index among those of one
   tick) and floods ``RelayAccepted``; other offers lapse after ``OFFER_TIMEOUT_UNITS``.
+  It then awaits that relay: it neither asks again nor retreats for
+  ``OFFER_TIMEOUT_UNITS`` plus ``JOURNEY_UNITS_PER_LEG`` per leg of its route (the
+  relay's way to it, at most back to the root and out again), or until it moves on.
+  (Asking again at once, as a requester still stuck would, recruits every free robot
+  in as many ticks, and one that retreats before its relay arrives leaves it waiting
+  for nobody: on bodies, where relays queue for vertex areas, a livelock.)
 * **Transit.** The relay suspends its own task (its strategy is not asked anything and no
   beacon is written until it resumes), goes back to the last vertex where its route and the
   requester's agree, then along the requester's route and leg, and stops where the
@@ -33,8 +39,9 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   free to serve, and retreats again after as long.
 
 * **Held on the way.** A relay that the world holds on its way (a body ahead on its lane,
-  a vertex area it may not enter yet) for as long as it waits at a leash stops where it
-  is and relays from there, as one the leash stops. A robot held by the world stands by
+  a vertex area it may not enter yet, on a lane or on a vertex centre where it waits for
+  it) for as long as it waits at a leash stops where it is and relays from there, as one
+  the leash stops. A robot held by the world stands by
   necessity, for as long as what holds it lasts, so it counts as settled (below).
 
 * **Settled robots adopt.** A robot's beat says it stands still only when it stands by
@@ -75,6 +82,9 @@ RELAY_PATIENCE_UNITS = 4.0
 RETREAT_AFTER_UNITS = RECRUIT_AFTER_UNITS + OFFER_TIMEOUT_UNITS
 #: How long a robot in reserve hears no request before it resumes its task.
 RESUME_AFTER_UNITS = 5.0
+#: How long a requester awaits the relay it accepted, per leg of its route (an edge's
+#: traversal there and back, with room for waits at vertices), after OFFER_TIMEOUT_UNITS.
+JOURNEY_UNITS_PER_LEG = 2.0
 
 EXPLORE, TRANSIT, RELAY, RETURN, RETREAT, RESERVE, RETIRED = (
     "explore", "transit", "relay", "return", "retreat", "reserve", "retired")
@@ -186,6 +196,7 @@ class ConnectedExplorer:
         self.consulted = False
         self.serial = 0
         self.request: tuple[int, int] | None = None  # (serial, tick) of an open request
+        self.awaiting_until: int | None = None  # tick until which it awaits its relay
         self.offer: tuple[Hashable, int, int] | None = None  # (requester, serial, tick)
         self.plan: list[tuple] = []
         self._goal: tuple = ((), None, 0.0)  # what ``plan`` leads to (:meth:`_head_for`)
@@ -223,6 +234,8 @@ class ConnectedExplorer:
             if mine:
                 best = min(mine, key=lambda o: o.offerer)
                 self.request = None
+                self.awaiting_until = tick + self._waits.offer + round(
+                    JOURNEY_UNITS_PER_LEG * (len(self.route) + 1) * self.tether.ticks_per_unit)
                 accepted = RelayAccepted(self.index, best.serial, best.offerer)
                 self.flood.fresh(accepted)
                 out.append(Message(accepted))
@@ -391,7 +404,13 @@ class ConnectedExplorer:
         blocked = wanted is not None and not self.tether.children
         self.stuck = self.stuck + 1 if blocked else 0
         self.held = self.held + 1 if held else 0
-        if self.mode in (EXPLORE, RETURN) and self.stuck >= waits.recruit and self.leg is not None:
+        if self.awaiting_until is not None and (not self.stuck or tick >= self.awaiting_until):
+            if self.stuck:  # its relay did not come: ask again, then retreat as before
+                self.stuck = waits.recruit
+            self.awaiting_until = None
+        awaiting = self.awaiting_until is not None
+        if (self.mode in (EXPLORE, RETURN) and self.stuck >= waits.recruit and not awaiting
+                and self.leg is not None):
             if self.request is None or tick - self.request[1] > waits.offer:
                 self.serial += 1
                 self.request = (self.serial, tick)
@@ -401,11 +420,12 @@ class ConnectedExplorer:
                 out.append(Message(w))
         if self.offer is not None and tick - self.offer[2] > waits.offer:
             self.offer = None
-        if self.mode == TRANSIT and self.under_way and max(self.stuck, self.held) >= waits.recruit:
-            self._become_relay_here()
+        if self.mode == TRANSIT and (self.under_way or held) and max(
+                self.stuck, self.held) >= waits.recruit:
+            self._become_relay_here()  # held on its way, on an edge or on a centre
         if self.mode == RELAY:
             self._relay_tick(tick)
-        if self.mode in (EXPLORE, RETURN) and self.stuck >= waits.retreat:
+        if self.mode in (EXPLORE, RETURN) and self.stuck >= waits.retreat and not awaiting:
             if self.task is None:
                 self.task = (tuple(self.route), self.leg, self.progress)
             self.mode, self.request = RETREAT, None
