@@ -43,7 +43,7 @@ from algorithms.exploration.base import BeaconHandle
 from algorithms.exploration.tether import BASE
 from algorithms.robot import NOTHING, Command, LegSense, Observation, VertexSense
 from mjswarm.arena.geometry import Wall
-from mjswarm.core.radio import Radio
+from mjswarm.core.radio import Blocker, Radio
 from mjswarm.errors import MjswarmError
 from mjswarm.worlds.graphworld import GraphWorld
 from mjswarm.worlds.loop import World
@@ -82,9 +82,11 @@ class RadioGraphWorld(World):
                                  graph.pos[u][1] - graph.pos[v][1])
                         for v, u in graph.duration}
         self._share = {e: 1.0 / (d * TICKS_PER_UNIT) for e, d in graph.duration.items()}
-        #: the longest step a robot takes in a tick (m)
-        self.step_m = max((self._share[e] * math.hypot(*self._vector[e]) for e in self._share),
-                          default=0.0)
+        #: the step a robot takes in a tick on each edge (m), and from each vertex, the
+        #: longest of its edges' (its next edge is its strategy's)
+        self._step_m = {e: self._share[e] * math.hypot(*self._vector[e]) for e in self._share}
+        self._vertex_step_m = {v: max((m for (a, _), m in self._step_m.items() if a == v),
+                                      default=0.0) for v in graph.pos}
         self.uplinks = {}
         self.reset(0)
 
@@ -116,13 +118,11 @@ class RadioGraphWorld(World):
         self._robot_out: list = []
         self._node_out: list = []
         self.radio = None
-        masts = dict.fromkeys([*self.fixed, *self.docked], self.mast_m)
-        blocked = self.fading = None
-        if self.walls is not None:
-            blocked = wall_blocker(self.walls, self._xy, masts)
-            #: the links that fade (their line passes within a step of a wall:
-            #: :meth:`_around`); None in the open model
-            self.fading = wall_blocker(self.walls, self._xy, masts, grow_m=self.step_m)
+        self._masts = dict.fromkeys([*self.fixed, *self.docked], self.mast_m)
+        blocked = None if self.walls is None else wall_blocker(self.walls, self._xy,
+                                                               self._masts)
+        #: by step (m): the links that fade within that step of a wall (:meth:`_around`)
+        self._fading: dict[float, Blocker] = {}
         self.attach_radio(Radio([*range(n_robots), *self.fixed], range_m=self.range_m,
                                 blocked=blocked))
 
@@ -236,14 +236,19 @@ class RadioGraphWorld(World):
 
     def _around(self, i: int) -> dict:
         """Robot ``i``'s range-and-bearing sensing of its radio neighbours (m, relative).
-        With walls, a neighbour whose link fades (its line passes within one step,
-        :attr:`step_m`, of a wall) gets no fix, as on the MuJoCo robots
-        (:data:`~mjswarm.core.radio.FADE_MARGIN_M`): a point that treats it as lost
-        backs off before its next step could take the link (the line at a wall moves
-        less than the robot does)."""
+        With walls, a neighbour whose link fades (its line passes within one of the
+        robot's steps of a wall, in plan and in height: the step on its edge, or the
+        longest from its vertex) gets no fix, as on the MuJoCo robots
+        (:data:`~mjswarm.core.radio.FADE_MARGIN_M`): a point that treats it as lost backs
+        off before its next step could take the link. Points step a tenth of an edge in a
+        tick, so on long edges the margin is wide and the points cautious."""
         (x, y), xy = self._xy[i], self._xy
         neighbours = self.radio.neighbors(i)
-        if self.fading is not None and len(neighbours):
-            faded = self.fading(np.array([(i, r) for r in neighbours], object))
+        if self.walls is not None and len(neighbours):
+            step = (self._vertex_step_m[self.at[i]] if self.at[i] is not None
+                    else self._step_m[self.edge[i]])
+            if step not in self._fading:
+                self._fading[step] = wall_blocker(self.walls, self._xy, self._masts, step)
+            faded = self._fading[step](np.array([(i, r) for r in neighbours], object))
             neighbours = [r for r, fades in zip(neighbours, faded) if not fades]
         return {r: (xy[r][0] - x, xy[r][1] - y) for r in neighbours}
