@@ -14,8 +14,8 @@ the base (ground truth); the MuJoCo cell adds contact events and robots stopped 
     python benchmarks/docs_tables.py connected     # the same table, for the docs
     python benchmarks/connected_worlds.py --grid   # 40 cases: arenas, K, R, seeds, speeds
 
-``--grid`` runs ``GRID`` (ten arenas, four teams each, with tie-breaking seeds and two
-speeds) in the graph world with walls and on the MuJoCo robots, one row per case, then
+``--grid`` runs ``GRID`` (ten arenas, two teams each, each with tie-breaking seed 1 at
+0.1 m/s and seed 2 at 0.15 m/s) in the graph world with walls and on the MuJoCo robots, one row per case, then
 counts: where each world completes, where the bodies complete as the points do, and
 contacts, cut ticks and robots stopped on the bodies.
 """
@@ -37,9 +37,9 @@ CASES = [("arena2", 4, 1.5), ("arena2", 4, 2.5), ("tree1", 5, 1.2), ("tree1", 5,
          ("hex:3x3", 6, 3.0), ("random-planar:10:3", 4, 1.5), ("random-planar:10:3", 4, 2.5)]
 #: The MuJoCo robots' cruising speed (m/s).
 SPEED_M_S = 0.1
-#: (arena, K, R (m), seed, speed (m/s)): ten arenas (the paper's, trees, lattices,
-#: hexagonal and triangular lattices, a wheel, random planar arenas and graphs), four
-#: teams each.
+#: (arena, K, R (m), seed, speed (m/s)): ten arenas (the paper's, a tree, lattices,
+#: hexagonal and triangular lattices, a wheel, a random planar arena and a random tree),
+#: two teams each, each with seed 1 at 0.1 m/s and seed 2 at 0.15 m/s.
 GRID = [(arena, k, range_m, seed, speed)
         for arena, teams in [
             ("arena1", [(2, 1.5), (3, 2.5)]), ("arena2", [(3, 1.5), (4, 2.5)]),
