@@ -104,7 +104,8 @@ from mjswarm.arena import ArenaSpec
 from mjswarm.arena.builder import arena_world_spec
 from mjswarm.core.bearing import BearingSensor
 from mjswarm.arena.geometry import corridor_walls
-from mjswarm.core.radio import BASE_MAST_M, FADE_MARGIN_M, Radio, Uplink, sight_blocker
+from mjswarm.core.radio import (BASE_MAST_M, FADE_MARGIN_M, FADE_TOP_M, Radio, Uplink,
+                                 sight_blocker)
 from mjswarm.core.simulation import Simulation
 from mjswarm.errors import RunInterrupted
 from mjswarm.experiments.awareness import BeliefSampling, TetherTruth
@@ -205,7 +206,7 @@ class EmbodiedExploration(LoopFunctions):
             self.world.fading = wall_blocker(
                 corridor_walls(spec), self.world.positions,
                 dict.fromkeys([*self.world.fixed, *self.world.docked], BASE_MAST_M),
-                grow_m=FADE_MARGIN_M)
+                grow_m=FADE_MARGIN_M, grow_top_m=FADE_TOP_M)
         if config.radio_range_m is not None:
             self.world.attach_radio(Radio([*range(k), *self.world.fixed],
                                           range_m=config.radio_range_m,

@@ -58,15 +58,17 @@ def _crossings(a: np.ndarray, b: np.ndarray, sides: np.ndarray) -> np.ndarray:
 
 
 def wall_blocker(walls: Sequence[Wall], positions: Mapping[Hashable, Sequence[float]],
-                 masts: Mapping[Hashable, float], grow_m: float = 0.0) -> Blocker:
+                 masts: Mapping[Hashable, float], grow_m: float = 0.0,
+                 grow_top_m: float | None = None) -> Blocker:
     """The radio's :data:`~mjswarm.core.radio.Blocker` for points among ``walls``: for each
     pair, whether the line between the antennas passes through a wall (module
     docstring). ``positions`` (m, read at call time) by node; ``masts``: the antenna
     height (m) of each fixed node (every other node is a robot). With ``grow_m`` (m), the
-    walls are grown by that much on every side and in height: the links that pass within
-    about ``grow_m`` of a wall (a fading link, :data:`~mjswarm.core.radio.FADE_MARGIN_M`)."""
+    walls are grown by that much on every side, and by ``grow_top_m`` (default
+    ``grow_m``) in height: the links that pass within about ``grow_m`` of a wall (a fading
+    link, :data:`~mjswarm.core.radio.FADE_MARGIN_M`)."""
     sides = wall_boxes(walls, grow_m)
-    top_m = WALL_HEIGHT_M + grow_m
+    top_m = WALL_HEIGHT_M + (grow_m if grow_top_m is None else grow_top_m)
 
     def blocked(pairs: np.ndarray) -> np.ndarray:
         pairs = np.asarray(pairs, object).reshape(-1, 2)
