@@ -134,3 +134,23 @@ def test_ground_truth_counts_the_links_walls_block():
     walls = corridor_walls(spec)
     assert cut("none", walls) > cut("none", None) > 0
     assert cut("connected", walls) == 0
+
+
+def test_the_fade_over_a_wall_top_is_set_apart():
+    """``grow_top_m`` grows the walls in height only: links between robots (antennas below
+    the walls' tops) fade the same whatever it is; lines from the mast fade less with a
+    lower top, and some fade only with the full margin."""
+    spec, rng = load_arena("arena2"), np.random.default_rng(2)
+    walls, where = corridor_walls(spec), {}
+    masts = {BASE: BASE_MAST_M}
+    full = wall_blocker(walls, where, masts, grow_m=0.05)
+    low = wall_blocker(walls, where, masts, grow_m=0.05, grow_top_m=0.0)
+    points = on_edges(spec, rng, 400) + rng.uniform(-LANE_OFFSET_M, LANE_OFFSET_M, (400, 2))
+    root, only_full = spec.vertices[spec.root], 0
+    for p, q in points.reshape(-1, 2, 2):
+        where.update({0: p, 1: q, BASE: root})
+        robots, mast = np.array([[0, 1]], object), np.array([[BASE, 0]], object)
+        assert full(robots)[0] == low(robots)[0]
+        assert full(mast)[0] or not low(mast)[0]
+        only_full += bool(full(mast)[0] and not low(mast)[0])
+    assert only_full > 0
