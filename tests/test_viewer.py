@@ -118,3 +118,36 @@ def test_view_web_serves_the_viewer_and_stops_on_ctrl_c(graph_recordings):
             proc.wait()
     assert proc.returncode in (0, 130) and "Traceback" not in err
     assert not port_open(port)
+
+
+#: tgkill(2)'s system call number, by machine (a signal to one thread of a process).
+TGKILL = {"x86_64": 234, "aarch64": 131}
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux") or os.uname().machine not in TGKILL,
+                    reason="tgkill is a Linux system call")
+def test_view_web_stops_when_a_native_thread_takes_the_ctrl_c(graph_recordings):
+    """A process-directed SIGINT may land on any thread that does not block it, and
+    rerun's SDK runs native threads in ``mjswarm view``'s process: the signal sent to one
+    of them must still stop the server (a main thread blocked in ``waitpid`` never
+    woke, and the server ran on)."""
+    import ctypes
+
+    port = free_port()
+    proc = subprocess.Popen([sys.executable, "-m", "mjswarm.cli", "view",
+                             str(graph_recordings["graph"]), "--web", "--port", str(port)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO,
+                            env=_env())
+    try:
+        assert f"http://127.0.0.1:{port}/?url=" in proc.stdout.readline()
+        others = [int(t) for t in os.listdir(f"/proc/{proc.pid}/task") if int(t) != proc.pid]
+        assert others, "rerun's SDK runs no native thread here: the case is not exercised"
+        libc = ctypes.CDLL(None, use_errno=True)
+        assert libc.syscall(TGKILL[os.uname().machine], proc.pid, others[0], signal.SIGINT) == 0
+        _, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130 and "interrupted" in err
+    assert not port_open(port)

@@ -93,6 +93,18 @@ def serve(files: list[str | Path], timeout_s: float = 30.0) -> Iterator[str]:
         log.close()
 
 
+def wait_interruptibly(proc: subprocess.Popen, poll_s: float = 0.1) -> int:
+    """Wait for ``proc`` to exit and return its status, waking every ``poll_s`` seconds.
+
+    Not ``proc.wait()``: rerun's SDK runs native threads in this process, and a Ctrl-C
+    (SIGINT) that the kernel hands to one of them would not interrupt the main thread
+    blocked in ``waitpid``; Python raises :class:`KeyboardInterrupt` only once the main
+    thread runs again, which a short sleep guarantees."""
+    while proc.poll() is None:
+        time.sleep(poll_s)
+    return proc.returncode
+
+
 def stop(proc: subprocess.Popen) -> None:
     """End ``proc`` if it still runs: SIGTERM, then SIGKILL after 10 s."""
     if proc.poll() is None:
@@ -135,7 +147,7 @@ def serve_web(path: str | Path, port: int | None = None, grpc_port: int | None =
               f"(from another machine: ssh -L {web}:127.0.0.1:{web} -L "
               f"{grpc}:127.0.0.1:{grpc} HOST, then the same address); Ctrl-C stops",
               file=out, flush=True)
-        return proc.wait()
+        return wait_interruptibly(proc)
     finally:
         stop(proc)
 
