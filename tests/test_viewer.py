@@ -79,6 +79,13 @@ def test_connected_graph_recording_has_the_tethers(graph_recordings):
             "/map/R3", "/matrices/R3"} <= names
 
 
+def _serve_web(recording: Path, port: int) -> subprocess.Popen:
+    """``mjswarm view RECORDING --web --port PORT`` in a process of its own."""
+    return subprocess.Popen([sys.executable, "-m", "mjswarm.cli", "view", str(recording),
+                             "--web", "--port", str(port)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, cwd=REPO, env=_env())
+
+
 def _env(**extra) -> dict[str, str]:
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(REPO), env.get("PYTHONPATH")]))
@@ -97,10 +104,7 @@ def test_view_without_display_names_web(graph_recordings):
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child is POSIX")
 def test_view_web_serves_the_viewer_and_stops_on_ctrl_c(graph_recordings):
     port = free_port()
-    proc = subprocess.Popen([sys.executable, "-m", "mjswarm.cli", "view",
-                             str(graph_recordings["graph"]), "--web", "--port", str(port)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO,
-                            env=_env())
+    proc = _serve_web(graph_recordings["graph"], port)
     try:
         line = proc.stdout.readline()
         assert f"http://127.0.0.1:{port}/?url=" in line, line
@@ -134,10 +138,7 @@ def test_view_web_stops_when_a_native_thread_takes_the_ctrl_c(graph_recordings):
     import ctypes
 
     port = free_port()
-    proc = subprocess.Popen([sys.executable, "-m", "mjswarm.cli", "view",
-                             str(graph_recordings["graph"]), "--web", "--port", str(port)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO,
-                            env=_env())
+    proc = _serve_web(graph_recordings["graph"], port)
     try:
         assert f"http://127.0.0.1:{port}/?url=" in proc.stdout.readline()
         others = [int(t) for t in os.listdir(f"/proc/{proc.pid}/task") if int(t) != proc.pid]
