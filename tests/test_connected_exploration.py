@@ -286,6 +286,23 @@ def test_a_robot_with_children_holds():
     assert not t.children
 
 
+def test_a_parent_whose_children_the_world_holds_may_step_keeping_them_in_range():
+    """Rule 2's exception: a parent steps only while every child's last beat says the
+    world holds it, and only by steps that keep every child within the leash; a child
+    that moves, or whose beat has not come, makes it hold again."""
+    around = {BASE: (-0.5, 0.0), 2: (0.9, 0.0)}
+    t = Tether(1, range_m=1.0)
+    t.hear(1, [Message(Beat((), 0, True, 0, 0), sender=BASE),
+               Message(Beat((1,), 2, True, 0, 0, held=True), sender=2)], around)
+    assert t.children == {2} and not t.holds()
+    assert t.may_step((0.05, 0.0), around)
+    assert not t.may_step((-0.15, 0.0), around)  # the child would be 1.05 m away
+    t.hear(2, [Message(Beat((1,), 2, False, 0, 0), sender=2)], around)
+    assert t.holds() and not t.may_step((0.05, 0.0), around)
+    t.hear(3, [Message(Adopt(), to=1, sender=3)], around)  # adopted: no beat of it yet
+    assert t.holds() and not t.may_step((0.0, 0.0), around)
+
+
 def test_a_biconnected_robot_needs_both_parents_within_the_leash():
     t = Tether(2, range_m=1.0, parents=(BASE, 0))
     t.hear(1, [Message(Beat((), 0, True, 0, 0), sender=BASE),

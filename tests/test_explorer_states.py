@@ -121,6 +121,9 @@ class Tied:
     def may_step(self, *args, back=False) -> bool:
         return True
 
+    def holds(self) -> bool:
+        return bool(self.children)
+
     def direction(self, progress: float) -> int:
         return self.sense
 

@@ -298,7 +298,7 @@ class Explorer(Controller):
         tied = [m for m in observation.inbox if m.sender != STATION]
         # leaving a vertex (granted the next one) it adopts nobody: it would hold both
         out += self.connected.hear(now, tied, around, willing=self.mode not in HOLDS_BEHIND)
-        if self.mode is Mode.WITHDRAWN and not self.tether.children:
+        if self.mode is Mode.WITHDRAWN and not self.tether.holds():
             self._enter(Mode.ASKING)  # free to go: ask again
             out.append(Message(self._asked, STATION))
         if self.connected.relay_trips != self._trips:
@@ -695,7 +695,7 @@ class Explorer(Controller):
         elif self.mode is Mode.WALKING_BACK_UNTOLD:  # it turned meanwhile: no lane request
             self._enter(Mode.WALKING_BACK)
         elif self.mode in WAITING:
-            if payload.clear and self.tether is not None and self.tether.children:
+            if payload.clear and self.tether is not None and self.tether.holds():
                 if self.mode is not Mode.WITHDRAWN:
                     self._enter(Mode.WITHDRAWN)
                 out.append(Message(Withdraw(), STATION))  # it must hold: give it back

@@ -9,12 +9,12 @@ tether's stall verdict, rule 5)::
                --done, cut off-------------------------> FINISHED
     IDLE       --idle_wait_s, a relay mission----------> DECIDING
     ASKING     --EntryGranted--------------------------> LEAVING
-               --EntryGranted clear, has children------> WITHDRAWN  (Withdraw)
+               --EntryGranted clear, must hold---------> WITHDRAWN  (Withdraw)
                --ungranted GIVE_UP_S-------------------> GIVING_UP  (GiveUp)
                --EntryBlocked, a relay mission---------> DECIDING
     GIVING_UP  --EntryGranted--------------------------> LEAVING
                --EntryBusy, EntryBlocked---------------> DECIDING
-    WITHDRAWN  --no children---------------------------> ASKING     (EntryRequest)
+    WITHDRAWN  --free to move--------------------------> ASKING     (EntryRequest)
                --EntryBlocked, a relay mission---------> DECIDING
     LEAVING    --in its corridor-----------------------> ON_LANE    (LeftVertex)
                --must walk back, no room to turn-------> TURN_ASKED_LEAVING (TurnedBack)
@@ -55,7 +55,7 @@ class Mode(Enum):
     IDLE = "idle"  # its strategy answered idle: it asks again after ``idle_wait_s``
     ASKING = "asking to enter"  # decided to leave; its EntryRequest is out
     GIVING_UP = "giving up"  # sent GiveUp for its request; no answer yet
-    WITHDRAWN = "withdrawn"  # gave a clear grant back (rule 2): asks again once childless
+    WITHDRAWN = "withdrawn"  # gave a clear grant back (rule 2): asks again once free to move
     LEAVING = "leaving"  # on its way, holding the vertex it left until in its corridor
     ON_LANE = "on the lane"  # on its way, clear of the vertex it left
     TURN_ASKED_LEAVING = "asking to turn, leaving"  # as TURN_ASKED, in the area it left
@@ -90,14 +90,14 @@ TRANSITIONS: dict[Mode, dict[Mode, str]] = {
     Mode.IDLE: {Mode.DECIDING: "idle_wait_s passed (at once on a relay mission)"},
     Mode.ASKING: {
         Mode.LEAVING: "EntryGranted: it departs",
-        Mode.WITHDRAWN: "EntryGranted clear while it has children (rule 2): Withdraw",
+        Mode.WITHDRAWN: "EntryGranted clear while it must hold for a child (rule 2): Withdraw",
         Mode.GIVING_UP: "ungranted for GIVE_UP_S: GiveUp",
         Mode.DECIDING: "EntryBlocked, or it sets out as a relay (Withdraw)"},
     Mode.GIVING_UP: {
         Mode.LEAVING: "EntryGranted (the grant overtook its GiveUp): it departs",
         Mode.DECIDING: "EntryBusy (it plans round that edge) or EntryBlocked"},
     Mode.WITHDRAWN: {
-        Mode.ASKING: "no children left: it asks again",
+        Mode.ASKING: "no child to hold for (none, or all held by the world): it asks again",
         Mode.DECIDING: "EntryBlocked, or it sets out as a relay"},
     Mode.LEAVING: {
         Mode.ON_LANE: "in its corridor: LeftVertex",

@@ -435,7 +435,7 @@ class ConnectedExplorer:
             self.mode = RETURN
             self._head_for(*self.task)
         out.append(self.tether.beat(tick, moved or not self._settled(), self.progressed,
-                                    len(self.mind.map_edges())))
+                                    len(self.mind.map_edges()), held))
         self.progressed = False
         return out
 

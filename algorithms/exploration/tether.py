@@ -21,6 +21,16 @@ rule below is ours (the papers give none for this combination):
 2. **Holding** (Kobayashi et al.'s repeater role). A robot with children does not move: it relays.
    Its children are the robots whose last beat named it as parent, and those it adopted
    in the last ``ADOPT_GRACE_TICKS`` ticks (their first beat naming it is on its way).
+   One exception (ours, for bodies): when every child's last beat says the world holds
+   it (it waits for a vertex area or a lane, not for its leash), the parent may step,
+   as long as every child stays within the leash too (:meth:`Tether.holds`). A child
+   held on a vertex centre may be waiting for the very vertex its parent stands on, and
+   then neither would ever move (``fig9``, five robots at 2.5 m: a parent on a vertex
+   granted its next one, its child on the vertex beyond asking for the parent's). A
+   held child does not move, and once it may, it checks its own step against where its
+   parent is then; on bodies a tick's move (at most 4 mm) is well inside the tether's
+   margin. Points share vertices and never report being held, so in the graph world
+   the rule is the plain one.
 3. **Leash.** A robot without children takes a step only if, after the step, its parents
    are within range ``R - margin - reserve`` of it, or no farther than before (a body may
    coast a little past the leash; it may always come back). A step of a walk back may use
@@ -83,13 +93,16 @@ BASE = "base"
 class Beat(NamedTuple):
     """Sent by every robot every tick: its parents, its hops from the base, whether it
     stood still in its last tick, the last tick at which it knows an exploring robot
-    reached a vertex, and the most edges it knows a robot's map to hold (rule 5)."""
+    reached a vertex, the most edges it knows a robot's map to hold (rule 5), and
+    whether the world held it in its last tick (it wanted to move and waits for a
+    vertex area or a lane: rule 2's exception)."""
 
     parents: tuple
     depth: int
     still: bool
     last_progress: int
     known_edges: int
+    held: bool = False
 
 
 class Adopt(NamedTuple):
@@ -175,11 +188,17 @@ class Tether:
         radio neighbours are relative to it (m); ``back``: a step of a walk back, which
         may use the reserve. A step that brings no parent farther is always allowed: a
         body that coasted past the leash (or read one tick old ranges) may come back."""
-        if self.children or self.request is not None:
+        if self.holds() or self.request is not None:
             return False
         slack = self.reserve_m if back else 0.0
         return all(self._within(step, around.get(q), slack) or _nearer(step, around.get(q))
-                   for q in self.parents)
+                   for q in self.parents) and all(
+            self._within(step, around.get(c)) for c in self.children)
+
+    def holds(self) -> bool:
+        """Rule 2: whether it must stand still for its children: it has one that the
+        world does not hold (or whose beat has not yet come)."""
+        return any(c not in self.heard or not self.heard[c].held for c in self.children)
 
     def ask(self, tick: int, step: Sequence[float] | None,
             around: Mapping[Hashable, Sequence[float]], cut: Collection = ()) -> list[Message]:
@@ -217,15 +236,16 @@ class Tether:
             return []
         return self._request(best[1], tick, best[2])
 
-    def beat(self, tick: int, moved: bool, progressed: bool, known_edges: int) -> Message:
+    def beat(self, tick: int, moved: bool, progressed: bool, known_edges: int,
+             held: bool = False) -> Message:
         """Rule 5's gossip, and what the others need of rules 2 and 4: ``progressed``
         when this robot reached a vertex while exploring in this tick, ``known_edges``
-        the edges of its map."""
+        the edges of its map, ``held`` when the world held it in this tick."""
         if progressed:
             self.last_progress = tick
         self.known_edges = max(self.known_edges, known_edges)
         return Message(Beat(self.parents, self.depth, not moved, self.last_progress,
-                            self.known_edges))
+                            self.known_edges, held))
 
     def stalled(self, tick: int) -> bool:
         """Rule 5: no exploring arrival known anywhere for the patience it states."""
