@@ -372,7 +372,8 @@ def summary(result: dict) -> str:
             lines.append(f"stalled: no robot reached a new vertex for a while (the "
                          f"tether's rule 5), though {result['robots_needed']} robots could "
                          f"reach every edge at this range: the team did not find the way "
-                         f"(more robots or range may help)")
+                         f"(its relays could not get where they were needed); a longer "
+                         f"range needs fewer relays")
     if "radio_range_m" in result:
         lines.append(
             f"radio {result['radio_range_m']:g} m"
