@@ -465,6 +465,18 @@ def test_embodied_biconnected_team_reports_when_its_docked_robot_fails():
     assert result.stopped_robots[0]["robot"] == 1 and result.collisions == 0
 
 
+@pytest.mark.slow  # test_a_parent_whose_children_the_world_holds_may_step... holds the rule
+def test_embodied_a_parent_makes_way_for_a_child_waiting_for_its_vertex():
+    """fig9, 5 robots at 2.5 m, seed 1, 10 cm/s: a parent on a vertex centre, granted its
+    next vertex, holds it for a child on the vertex beyond that waits for that very
+    vertex; with rule 2's exception the parent steps and the team completes (under the
+    plain rule the whole team stands still from 336 s on, all 12 edges explored, until
+    its stall)."""
+    result = embodied("fig9", 5, 2.5, seed=1, connectivity="connected", speed_m_s=0.1)
+    assert result.completed and result.map_correct
+    assert result.collisions == 0 and result.cut_ticks == 0 and not result.stopped_robots
+
+
 @pytest.mark.slow
 def test_embodied_too_short_a_range_ends_in_a_verdict():
     """1.5 m: walls cut links the leash cannot foresee; the robots back out of each cut
