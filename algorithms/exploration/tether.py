@@ -31,15 +31,16 @@ rule below is ours (the papers give none for this combination):
    parent is then; on bodies a tick's move (at most 4 mm) is well inside the tether's
    margin. Points share vertices and never report being held, so in the graph world
    the rule is the plain one.
-3. **Leash.** A robot without children takes a step only if, after the step, its parents
-   are within range ``R - margin - reserve`` of it, or no farther than before (a body may
-   coast a little past the leash; it may always come back). A step of a walk back may use
+3. **Leash.** A robot that does not hold (rule 2) takes a step only if, after the step,
+   its parents (and the children it may step for) are within range ``R - margin -
+   reserve`` of it, or no farther than before (a body may coast a little past the leash;
+   it may always come back). A step of a walk back may use
    the reserve as well (0 in the graph world; on bodies the width of a U-turn, which
    sidesteps across the lane and may take a robot at the end of its leash farther). It
    knows where its radio neighbours are relative to itself (a range-and-bearing sensor,
-   as Kobayashi et al.'s robots have) and what its own step will be. Parents hold and the base
-   never moves, so every tree link survives every tick, and nobody is ever cut off from
-   the base.
+   as Kobayashi et al.'s robots have) and what its own step will be. Parents hold (or step
+   only within the leash of children the world holds still) and the base never moves, so
+   every tree link survives every tick, and nobody is ever cut off from the base.
 4. **Adoption, make before break.** A robot without children whose step the leash forbids
    asks one still neighbour (or the base) that would allow the step to adopt it: the
    fewest tree hops from the base first, then the nearest. So does one that sees a still
@@ -186,14 +187,14 @@ class Tether:
                  back: bool = False) -> bool:
         """Rule 3: whether to take ``step`` (m, this robot's displacement) given where its
         radio neighbours are relative to it (m); ``back``: a step of a walk back, which
-        may use the reserve. A step that brings no parent farther is always allowed: a
-        body that coasted past the leash (or read one tick old ranges) may come back."""
+        may use the reserve. A step that brings no parent (nor child it steps for) farther
+        is always allowed: a body that coasted past the leash (or read one tick old
+        ranges) may come back."""
         if self.holds() or self.request is not None:
             return False
         slack = self.reserve_m if back else 0.0
         return all(self._within(step, around.get(q), slack) or _nearer(step, around.get(q))
-                   for q in self.parents) and all(
-            self._within(step, around.get(c)) for c in self.children)
+                   for q in (*self.parents, *self.children))
 
     def holds(self) -> bool:
         """Rule 2: whether it must stand still for its children: it has one that the
