@@ -117,6 +117,8 @@ def scenarios(body) -> list[Driven]:
     nav.turn_back()
     assert nav.state is S.ARRIVING
     nav = drive().in_corridor()
+    nav.odometry.distance_m += 0.1
+    assert nav.room_to_turn
     nav.turn_back()  # a U-turn onto the opposite lane
     assert nav.state is S.LEAVING
     nav = drive().on_lane()
@@ -234,3 +236,15 @@ def test_a_lane_backed_off_its_start_by_the_leash_has_not_ended(body):
     for _ in range(10):
         tick(True)
     assert nav.state is S.ON_EDGE and nav.corridor is Corridor.BEFORE_WALL
+
+
+def test_a_robot_too_near_the_vertex_behind_for_a_u_turn_goes_back_along_the_spoke(body):
+    """In its corridor but without :attr:`~Navigator.room_to_turn`, a U-turn would end
+    with its line sensors short of where the opposite lane starts: it goes back by
+    odometry to the outer end of the spoke it left by and follows that spoke in."""
+    nav = Driven(body).in_corridor()
+    assert nav.in_corridor and not nav.room_to_turn
+    nav.turn_back()
+    assert nav.state is S.ARRIVING and nav.leg is Leg.BACK
+    seek = [m for m, _ in nav._plan if isinstance(m, SeekLine)]
+    assert len(seek) == 1 and math.isclose(seek[0].heading, math.pi)

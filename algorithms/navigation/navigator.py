@@ -273,23 +273,27 @@ class Navigator:
     def turn_back(self) -> None:
         """Head back to the vertex it left, from anywhere on its edge.
 
-        In its corridor: a U-turn onto the opposite lane (face back, sidestep two lane
-        offsets to the left, find the lane), then on as along any edge: the vertex is
-        where the new left wall ends (however little of it it saw: after a U-turn at the
-        far end of a short edge a few centimetres may be left; where its lane ends, if
-        it saw none), and the arrival is by the edge it left along. Arriving at the
-        vertex ahead (its lane ended): back by odometry to where the lane ended, then the
-        same U-turn. Short of its corridor (leaving, or on the lane before its wall): by
-        odometry to the outer end of the spoke it left by, then in along the spoke to the
-        centre and a scan, as on any arrival, by the edge it left along. All ours (seed
-        003's robots never turned back)."""
+        With :attr:`room_to_turn` in its corridor: a U-turn onto the opposite lane (face
+        back, sidestep two lane offsets to the left, find the lane), then on as along any
+        edge: the vertex is where the new left wall ends (however little of it it saw:
+        after a U-turn at the far end of a short edge a few centimetres may be left; where
+        its lane ends, if it saw none), and the arrival is by the edge it left along.
+        Arriving at the vertex ahead (its lane ended): back by odometry to where the lane
+        ended, then the same U-turn. Short of that room (leaving, on the lane before its
+        wall, or in its corridor too near the vertex behind): by odometry to the outer end
+        of the spoke it left by, then in along the spoke to the centre and a scan, as on
+        any arrival, by the edge it left along. (A U-turn there would end with its line
+        sensors short of where the opposite lane starts, and its seek find a neighbouring
+        edge's lane or nothing: ``hex:2x2``, 4 robots at 1.5 m, connected, 0.15 m/s, seed
+        2, lost a robot that turned 0.31 m along its edge.) All ours (seed 003's robots
+        never turned back)."""
         if self.state not in (NavigatorState.LEAVING, NavigatorState.ON_EDGE,
                               NavigatorState.ARRIVING):
             raise RuntimeError(f"turn_back() needs the robot on an edge, it is {self.state.value}")
         x, y, angle = self._left
         self._incoming, self.leg = angle, Leg.BACK
         odo = self.odometry
-        if self.in_corridor or self.state is NavigatorState.ARRIVING:
+        if self.room_to_turn or self.state is NavigatorState.ARRIVING:
             plan = []
             if self.state is NavigatorState.ARRIVING:
                 ex, ey, heading = self._lane_end
