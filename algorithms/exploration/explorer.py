@@ -30,11 +30,10 @@ It composes, fed only by its own observation:
   that its motion resumes from where the body is), and then
   stands as if the leash had stopped it (so it calls a relay, rule 6) until it has a new
   parent or sets out on a new leg; it may still walk back along its leg (rule 6), unless a
-  wall cut a link on the way back too (ours). A step out along a lane keeps its parents
-  within the leash of the point across its edge as well (rule 3: a walk back turns round
-  onto the opposite lane and follows it back, so a robot at the end of its leash can
-  always walk back), and one that turns back in the area of the vertex it arrived at
-  backs out of it at once (that area is its own).
+  wall cut a link on the way back too (ours). A step of a walk back may use the tether's
+  reserve (rule 3: a U-turn sidesteps across its edge, and a robot at the end of its
+  leash must still be able to turn), and one that turns back in the area of the vertex
+  it arrived at backs out of it at once (that area is its own).
 
 Its modes and the moves between them are in :mod:`algorithms.exploration.modes`.
 
@@ -317,18 +316,15 @@ class Explorer(Controller):
         moving = command.v_m_s != 0.0
         if moving and self._in_the_way(around, command.v_m_s):
             command, moving = Command(messages=command.messages), False
-        back = self.mode in RETURNING
-        out_on_lane = self.nav.on_lane and not back
         wanted = self.leash.check(
             (command.v_m_s, command.omega_rad_s) if moving else None,
-            (command.v_m_s * self.control_dt_s, 0.0), around, back,
-            at_centre=self.nav.state in (NavigatorState.SCANNING, NavigatorState.AT_VERTEX),
-            out_on_lane=out_on_lane)
+            (command.v_m_s * self.control_dt_s, 0.0), around, back=self.mode in RETURNING,
+            at_centre=self.nav.state in (NavigatorState.SCANNING, NavigatorState.AT_VERTEX))
         if wanted is not None:
             command = Command(messages=command.messages)
         out = list(command.messages)
         out += self.connected.after(now, wanted, command.v_m_s != 0.0, around, self._held,
-                                    self.leash.cut_on_this_way(back), out_on_lane)
+                                    self.leash.cut_on_this_way(self.mode in RETURNING))
         return command._replace(messages=tuple(out))
 
     def _set_out(self, observation: Observation, out: list[Message]) -> None:

@@ -172,7 +172,7 @@ class TetheredExplorer(Controller):
             sense = c.direction(progress)
             # the step off a vertex joins no trail: a retrace never walks back onto it
             if sense and self.leash.check(sense, steps[sense < 0], leg.around_m, sense < 0,
-                                          progress == 0.0) is not None:
+                                          progress == 0.0, reserve=False) is not None:
                 self._wanted, sense = steps[sense < 0], 0
         self._moved, self._back = sense != 0, sense < 0
         return Command(float(sense), 0.0, None, out, None, edge_rad,

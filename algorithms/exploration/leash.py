@@ -45,16 +45,16 @@ class Leash:
         return not all(q in around for q in self.tether.parents)
 
     def check(self, move: Any, step: Sequence[float], around: Mapping, back: bool,
-              at_centre: bool, out_on_lane: bool = False) -> Sequence[float] | None:
+              at_centre: bool, reserve: bool = True) -> Sequence[float] | None:
         """The ``step`` (m, the robot's displacement) of ``move`` that the leash, or a wall
         met on this way, forbids, or None: the move may go, and joins the trail (``move``
-        None: the robot stays). ``back``: it walks back along its leg; ``at_centre``: it
-        stands on a vertex centre, where nothing is backed out of; ``out_on_lane``: a step
-        out along a lane (:meth:`~algorithms.exploration.tether.Tether.may_step`)."""
+        None: the robot stays). ``back``: it walks back along its leg (and, with
+        ``reserve``, may use the tether's reserve); ``at_centre``: it stands on a vertex
+        centre, where nothing is backed out of."""
         wanted = None
         if move is not None:
             if self._way(back) in self._occluded or not self.tether.may_step(
-                    step, around, out_on_lane):
+                    step, around, back=back and reserve):
                 wanted = step
             else:
                 self._trail.append(move)

@@ -394,15 +394,13 @@ class ConnectedExplorer:
 
     # ------------------------------------------------------------------ end of tick
     def after(self, tick: int, wanted: Sequence[float] | None, moved: bool,
-              around: Mapping, held: bool = False, cut: Collection = (),
-              out_on_lane: bool = False) -> list[Message]:
+              around: Mapping, held: bool = False, cut: Collection = ()) -> list[Message]:
         """``wanted``: the step the leash forbade it (None if none); ``held``: it wanted to
         move and the world held it (a body ahead on its lane, a vertex not yet entered);
-        ``cut``: parents whose link that step would lose to a wall (rule 4's ``cut``);
-        ``out_on_lane``: that step was one out along a lane (rule 3)."""
+        ``cut``: parents whose link that step would lose to a wall (rule 4's ``cut``)."""
         self._tick = tick
         waits = self._waits
-        out = self.tether.ask(tick, wanted, around, cut, out_on_lane)
+        out = self.tether.ask(tick, wanted, around, cut)
         blocked = wanted is not None and not self.tether.children
         self.stuck = self.stuck + 1 if blocked else 0
         self.held = self.held + 1 if held else 0

@@ -32,18 +32,15 @@ rule below is ours (the papers give none for this combination):
    margin. Points share vertices and never report being held, so in the graph world
    the rule is the plain one.
 3. **Leash.** A robot that does not hold (rule 2) takes a step only if, after the step,
-   its parents (and the children it may step for) are within range ``R - margin`` of it,
-   or no farther than before (a body may coast a little past the leash; it may always
-   come back). On bodies a step out along a lane must also keep them within that range
-   of the point *across* the edge from where it ends, on the opposite lane
-   (``across_m``, two lane offsets to its right; 0 for points): a walk back turns round
-   onto that lane (a U-turn's sidestep) and follows it back beside the way it came, so
-   every point of the walk back lies across from a point it reached, and a robot at the
-   end of its leash can always walk back. It knows where its radio neighbours are
-   relative to itself (a range-and-bearing sensor, as Kobayashi et al.'s robots have) and
-   what its own step will be. Parents hold (or step only within the leash of children
-   the world holds still) and the base never moves, so every tree link survives every
-   tick, and nobody is ever cut off from the base.
+   its parents (and the children it may step for) are within range ``R - margin -
+   reserve`` of it, or no farther than before (a body may coast a little past the leash;
+   it may always come back). A step of a walk back may use
+   the reserve as well (0 in the graph world; on bodies the width of a U-turn, which
+   sidesteps across the lane and may take a robot at the end of its leash farther). It
+   knows where its radio neighbours are relative to itself (a range-and-bearing sensor,
+   as Kobayashi et al.'s robots have) and what its own step will be. Parents hold (or step
+   only within the leash of children the world holds still) and the base never moves, so
+   every tree link survives every tick, and nobody is ever cut off from the base.
 4. **Adoption, make before break.** A robot without children whose step the leash forbids
    asks one still neighbour (or the base) that would allow the step to adopt it: the
    fewest tree hops from the base first, then the nearest. So does one that sees a still
@@ -129,16 +126,17 @@ class Tether:
             ``biconnected``, see :func:`initial_parents`); it keeps as many.
         margin_m: the leash keeps the parents within ``R - margin_m``.
         ticks_per_unit: control ticks per time unit (for the stall rule).
-        across_m: how far to its right (m) the opposite lane of its edge lies, where a
-            walk back takes a body (rule 3; 0 for points).
+        reserve_m: of that leash, what only a walk back may use (rule 3): a body
+            turning back on its lane sidesteps across it, and one at the end of its
+            leash must still be able to (0 for points).
     """
 
     def __init__(self, me: Hashable, range_m: float, parents: tuple = (BASE,),
                  margin_m: float = 0.0, ticks_per_unit: int = 10,
-                 across_m: float = 0.0) -> None:
+                 reserve_m: float = 0.0) -> None:
         self.me = me
-        self.leash_m = range_m - margin_m
-        self.across_m = across_m
+        self.leash_m = range_m - margin_m - reserve_m
+        self.reserve_m = reserve_m
         self.ticks_per_unit = ticks_per_unit
         self.parents: tuple = tuple(parents)
         self.depth = 1
@@ -186,16 +184,16 @@ class Tether:
         return out
 
     def may_step(self, step: Sequence[float], around: Mapping[Hashable, Sequence[float]],
-                 out_on_lane: bool = False) -> bool:
-        """Rule 3: whether to take ``step`` (m, this robot's displacement in its own
-        frame, x ahead and y to its left) given where its radio neighbours are relative to
-        it (m, the same frame); ``out_on_lane``: a step out along a lane, which keeps the
-        point across the edge within the leash too. A step that brings no parent (nor
-        child it steps for) farther is always allowed: a body that coasted past the leash
-        (or read one tick old ranges) may come back."""
+                 back: bool = False) -> bool:
+        """Rule 3: whether to take ``step`` (m, this robot's displacement) given where its
+        radio neighbours are relative to it (m); ``back``: a step of a walk back, which
+        may use the reserve. A step that brings no parent (nor child it steps for) farther
+        is always allowed: a body that coasted past the leash (or read one tick old
+        ranges) may come back."""
         if self.holds() or self.request is not None:
             return False
-        return all(self._allows(step, around.get(q), out_on_lane) or _nearer(step, around.get(q))
+        slack = self.reserve_m if back else 0.0
+        return all(self._within(step, around.get(q), slack) or _nearer(step, around.get(q))
                    for q in (*self.parents, *self.children))
 
     def holds(self) -> bool:
@@ -204,16 +202,14 @@ class Tether:
         return any(c not in self.heard or not self.heard[c].held for c in self.children)
 
     def ask(self, tick: int, step: Sequence[float] | None,
-            around: Mapping[Hashable, Sequence[float]], cut: Collection = (),
-            out_on_lane: bool = False) -> list[Message]:
+            around: Mapping[Hashable, Sequence[float]], cut: Collection = ()) -> list[Message]:
         """Rule 4, asking side: after a tick in which this robot wanted to take ``step``
         (None: it wanted to stay) and did not, or could do with a parent nearer the base.
         With two parents it replaces one at a time: the first that forbids the step, else
         the one farthest from the base (in hops). ``cut``: parents whose link the step
         would lose for another reason than range (a wall, as the robot found). A parent
         missing from ``around`` (its link lost, or fading: a wall came between) blocks
-        whatever the step, even staying: any still neighbour in range may replace it.
-        ``out_on_lane`` as for :meth:`may_step`."""
+        whatever the step, even staying: any still neighbour in range may replace it."""
         if self.request is not None:
             return []
         deepest = max(self.parents, key=lambda q: self._depth_of(q))
@@ -222,17 +218,15 @@ class Tether:
                 return self._request(BASE, tick, deepest)
             return []
         blocking = [q for q in self.parents if q not in around or step is not None
-                    and (q in cut or not self._allows(step, around[q], out_on_lane))]
+                    and (q in cut or not self._within(step, around[q]))]
         best = None
         for r, beat in self.heard.items():
             if r in self.parents or not beat.still or r not in around:
                 continue
-            if blocking and (self._within((0.0, 0.0), around[r]) if step is None
-                             else self._allows(step, around[r], out_on_lane)):
+            if blocking and self._within(step or (0.0, 0.0), around[r]):
                 replaced = blocking[0]
             elif (beat.depth < self._depth_of(deepest) and self._within((0.0, 0.0), around[r])
-                  and (step is None or deepest in blocking
-                       or self._allows(step, around[r], out_on_lane))):
+                  and (step is None or deepest in blocking or self._within(step, around[r]))):
                 replaced = deepest  # never a parent that allows the step for one that forbids it
             else:
                 continue
@@ -267,20 +261,13 @@ class Tether:
     def _depth_of(self, q: Hashable) -> float:
         return 0 if q == BASE else self.heard[q].depth if q in self.heard else math.inf
 
-    def _within(self, step: Sequence[float], offset: Sequence[float] | None) -> bool:
-        """Whether a robot at ``offset`` (m, relative to here) is within the leash after
-        ``step``."""
+    def _within(self, step: Sequence[float], offset: Sequence[float] | None,
+                slack: float = 0.0) -> bool:
+        """Whether a robot at ``offset`` (m, relative to here) is within the leash (plus
+        ``slack``, m) after ``step``."""
         if offset is None:
             return False
-        return math.hypot(offset[0] - step[0], offset[1] - step[1]) <= self.leash_m
-
-    def _allows(self, step: Sequence[float], offset: Sequence[float] | None,
-                out_on_lane: bool) -> bool:
-        """Whether a robot at ``offset`` (m) is within the leash after ``step`` and, for
-        a step out along a lane, of the point across the edge from its end (rule 3)."""
-        across = (step[0], step[1] - self.across_m)
-        return self._within(step, offset) and not (
-            out_on_lane and self.across_m > 0.0 and not self._within(across, offset))
+        return math.hypot(offset[0] - step[0], offset[1] - step[1]) <= self.leash_m + slack
 
 
 def _nearer(step: Sequence[float], offset: Sequence[float] | None) -> bool:

@@ -20,9 +20,10 @@ from mjswarm.experiments.results import ExplorationResult
 #: The tether's leash keeps parents within the radio range less this (m): a control
 #: period's drive at top speed (4 mm), turns and the one-tick-old ranging, with room.
 TETHER_MARGIN_M = 0.02
-#: How far across its edge (m, the tether's ``across_m``) the opposite lane lies, which a
-#: walk back turns round onto and follows back (rule 3).
-ACROSS_LANES_M = 2 * LANE_OFFSET_M
+#: Of the leash, what only a walk back may use (m, the tether's ``reserve_m``): a U-turn
+#: sidesteps two lane offsets across its edge, with room for the odometry's back-up to
+#: where its lane ended.
+TURN_RESERVE_M = 2 * LANE_OFFSET_M + 0.02
 #: What pictures of a run say the marked vertices are.
 BEACON_LABEL = "beacon dropped (vertex explored)"
 #: Default stall timeout: at least this long (s), and at least STALL_EDGE_FACTOR times

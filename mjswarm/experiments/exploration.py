@@ -112,7 +112,7 @@ from mjswarm.experiments.awareness import BeliefSampling, TetherTruth
 from mjswarm.experiments.embodied import (  # noqa: F401 - the experiment's public names
     BEACON_LABEL,
     TETHER_MARGIN_M,
-    ACROSS_LANES_M,
+    TURN_RESERVE_M,
     EmbodiedConfig,
     EmbodiedResult,
     check_config,
@@ -235,7 +235,7 @@ class EmbodiedExploration(LoopFunctions):
                      sim.control_dt_s,
                      Tether(i, config.radio_range_m, initial_parents(i, need, first),
                             margin_m=TETHER_MARGIN_M, ticks_per_unit=ticks,
-                            across_m=ACROSS_LANES_M)
+                            reserve_m=TURN_RESERVE_M)
                      if tied and i not in world.docked else None)
             for i, (mind, e) in enumerate(zip(self.minds, eps))]
 
