@@ -114,13 +114,18 @@ def test_measured_angles_are_in_the_robots_own_frame():
     assert np.max(errors) < 3.0
 
 
-@pytest.mark.parametrize("drive_m", [0.05, 0.3, 0.7, 1.2, math.inf])
-def test_a_robot_turned_back_part_way_arrives_where_it_left_by_the_edge_it_left_along(drive_m):
+@pytest.mark.parametrize("arena, drive_m", [
+    *(("lattice:2x2:1.5", d) for d in (0.05, 0.3, "corridor", 0.7, 1.2, math.inf)),
+    ("hex:2x2", "corridor")])
+def test_a_robot_turned_back_part_way_arrives_where_it_left_by_the_edge_it_left_along(
+        arena, drive_m):
     """Rule 6's walks back (:meth:`Navigator.turn_back`): turned back while leaving (5 cm),
-    short of its corridor (0.3 m), on its lane (0.7 m, and 1.2 m, past the wall's end at
-    the far vertex of a 1.5 m edge) or arriving there (a second into its arrival), the robot is back on the centre it left, measures the
-    same edges, and reports the edge it left along as the one it came by."""
-    spec = load_arena("lattice:2x2:1.5")
+    short of its corridor (0.3 m), just in its corridor (without room for a U-turn: back
+    along the spoke it left by, on a vertex with edges 90 and 120 degrees apart), on its lane (0.7 m, and 1.2 m, past the wall's end at the far vertex of a
+    1.5 m edge) or arriving there (a second into its arrival), the robot is back on the
+    centre it left, measures the same edges, and reports the edge it left along as the
+    one it came by."""
+    spec = load_arena(arena)
     x, y = spec.vertices[spec.root]
     sim = Simulation(arena_world_spec(spec, [Pose2D(x, y, 0.0)]))
     nav = Navigator(calibration(sim.geometry), conventions(sim.geometry), 0.0, SPEED_M_S)
@@ -132,7 +137,12 @@ def test_a_robot_turned_back_part_way_arrives_where_it_left_by_the_edge_it_left_
     assert len(first) == 2
     nav.depart(first[0])
     start = nav.odometry.distance_m
-    while nav.odometry.distance_m - start < drive_m and nav.state is not NavigatorState.ARRIVING:
+    if drive_m == "corridor":
+        while not nav.in_corridor:
+            driver.step()
+        assert not nav.room_to_turn
+    while (drive_m != "corridor" and nav.odometry.distance_m - start < drive_m
+           and nav.state is not NavigatorState.ARRIVING):
         driver.step()
     for _ in range(50 if nav.state is NavigatorState.ARRIVING else 0):
         driver.step()
