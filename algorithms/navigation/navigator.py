@@ -284,9 +284,10 @@ class Navigator:
         of the spoke it left by, then in along the spoke to the centre and a scan, as on
         any arrival, by the edge it left along. (A U-turn there would end with its line
         sensors short of where the opposite lane starts, and its seek find a neighbouring
-        edge's lane or nothing: ``hex:2x2``, 4 robots at 1.5 m, connected, 0.15 m/s, seed
-        2, lost a robot that turned 0.31 m along its edge.) All ours (seed 003's robots
-        never turned back)."""
+        edge's lane or nothing: on ``hex:2x2``, 4 robots at 1.5 m, connected, 0.15 m/s,
+        seed 2, a robot turning 0.31 m along its edge would end 0.20 m from the centre,
+        its sensors short of the lane's start at 0.16 m, and be lost.) All ours
+        (Nagavarapu et al.'s robots never turned back)."""
         if self.state not in (NavigatorState.LEAVING, NavigatorState.ON_EDGE,
                               NavigatorState.ARRIVING):
             raise RuntimeError(f"turn_back() needs the robot on an edge, it is {self.state.value}")
