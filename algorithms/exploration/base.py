@@ -180,9 +180,9 @@ class Strategy(ABC):
         """Bookkeeping of an arrival that must reach the beacon before any robot arriving
         at the same time decides (Brass et al.'s model for MR-DFS). The graph world calls
         it for every robot of a simultaneous batch, then :meth:`on_vertex` for each; a
-        strategy that keeps its bookkeeping and decision together leaves it empty (seed
-        003's robots handle simultaneous arrivals one after another, see the module
-        docstring)."""
+        strategy that keeps its bookkeeping and decision together leaves it empty
+        (Nagavarapu et al.'s robots handle simultaneous arrivals one after another, see
+        the module docstring)."""
 
     @abstractmethod
     def on_vertex(

@@ -52,8 +52,9 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   wherever it happened to be (on ``lattice:1x8`` with five robots at 1 m, a robot
   adopted next to the base held there for the rest of the run).
 
-The walk is the robot's own: it follows incidence angles from vertex to vertex as seed
-003's robots do; routes name vertices by their beacons (each beacon's hardware identity).
+The walk is the robot's own: it follows incidence angles from vertex to vertex as
+Nagavarapu et al.'s robots do; routes name vertices by their beacons (each beacon's
+hardware identity).
 Walking back along an edge is the world's: the graph world reverses, a MuJoCo robot turns
 onto the opposite lane (:meth:`~algorithms.navigation.Navigator.turn_back`). The waits are
 in time units, so they keep their meaning at any control rate.
