@@ -121,10 +121,10 @@ def test_a_robot_turned_back_part_way_arrives_where_it_left_by_the_edge_it_left_
         arena, drive_m):
     """Rule 6's walks back (:meth:`Navigator.turn_back`): turned back while leaving (5 cm),
     short of its corridor (0.3 m), just in its corridor (without room for a U-turn: back
-    along the spoke it left by, on a vertex with edges 90 and 120 degrees apart), on its lane (0.7 m, and 1.2 m, past the wall's end at the far vertex of a
-    1.5 m edge) or arriving there (a second into its arrival), the robot is back on the
-    centre it left, measures the same edges, and reports the edge it left along as the
-    one it came by."""
+    along the spoke it left by, on a vertex with edges 90 and 120 degrees apart), on its
+    lane (0.7 m, and 1.2 m, past the wall's end at the far vertex of a 1.5 m edge) or
+    arriving there (a second into its arrival), the robot is back on the centre it left,
+    measures the same edges, and reports the edge it left along as the one it came by."""
     spec = load_arena(arena)
     x, y = spec.vertices[spec.root]
     sim = Simulation(arena_world_spec(spec, [Pose2D(x, y, 0.0)]))
