@@ -207,7 +207,68 @@ def test_a_requester_awaits_the_relay_it_accepted():
     assert robot.mode == RETREAT and tick - deadline <= waits.retreat
 
 
+def test_a_robot_that_can_take_no_step_keeps_asking_and_never_retreats_or_offers():
+    """Rule 6: a robot pinned by a wall (no step allowed, back included) asks for a relay
+    again and again instead of retreating, and offers itself to nobody; the same robot
+    merely stuck retreats."""
+    from algorithms.exploration.relay import EXPLORE, RETREAT, Leg
+
+    def stuck_for(pinned: bool):
+        robot = ConnectedExplorer(1, make_minds("incidence-dfs", 1, None)[0],
+                                  Tether(1, range_m=1.0))
+        robot.leg, asked = Leg("b0", 0.0), 0
+        for tick in range(1, 3 * robot._waits.retreat):
+            out = robot.after(tick, (0.1, 0.0), False, {}, pinned=pinned)
+            asked += sum(isinstance(m.payload, RelayWanted) for m in out)
+        return robot, asked, tick
+
+    pinned, asked, tick = stuck_for(True)
+    assert pinned.mode == EXPLORE and asked >= 2
+    offers = [m for m in pinned.hear(tick + 1, [_wanted(0)], {})
+              if isinstance(m.payload, RelayOffer)]
+    assert offers == []
+    assert stuck_for(False)[0].mode == RETREAT
+
+
+def test_a_beat_says_stuck_only_when_the_leash_stopped_it():
+    """Rule 4's ``stuck``: a robot whose leash forbade its step says so; one that holds for
+    a child on the move does not (a child the world holds would otherwise leave it for a
+    neighbour that is asking that child at the same time, and crossing requests refuse
+    each other for good)."""
+    robot = ConnectedExplorer(1, make_minds("incidence-dfs", 1, None)[0], Tether(1, range_m=1.0))
+    beat = lambda out: [m.payload for m in out if isinstance(m.payload, Beat)][-1]
+    assert beat(robot.after(1, (0.1, 0.0), False, {})).stuck
+    robot.tether.hear(2, [Message(Adopt(), to=1, sender=2)], {2: (0.5, 0.0)})
+    assert robot.tether.holds()
+    assert not beat(robot.after(2, (0.1, 0.0), False, {})).stuck
+    assert not beat(robot.after(3, None, False, {})).stuck
+
+
 # ---------------------------------------------------------------------------- the tether
+def test_a_child_the_world_holds_lets_a_parent_its_leash_stopped_go():
+    """Rule 4: a robot the world holds replaces a parent whose beat says its leash stopped
+    it by a still neighbour in range, so that the parent, left without children, may
+    adopt it or call a relay; not when it is not held, nor for a parent not stopped, nor
+    for a neighbour out of range."""
+    near = {0: (0.3, 0.0), 1: (-0.5, 0.0)}
+
+    def heard(stuck: bool) -> list[Message]:
+        return [Message(Beat((BASE,), 1, True, 0, 0, stuck=stuck), sender=0),
+                Message(Beat((BASE,), 1, True, 0, 0, held=True), sender=1)]
+
+    t = Tether(2, range_m=1.0, parents=(0,))
+    t.hear(1, heard(True), near)
+    assert t.ask(1, None, near) == []  # not held
+    t.hear(2, heard(False), near)
+    assert t.ask(2, None, near, held=True) == []  # its parent is not stopped
+    t.hear(3, heard(True), near)
+    assert t.ask(3, None, near, held=True) == [Message(Adopt(), to=1)] and t.request[2] == 0
+    far = {0: (0.3, 0.0), 1: (-1.2, 0.0)}
+    t = Tether(2, range_m=1.0, parents=(0,))
+    t.hear(1, heard(True), far)
+    assert t.ask(1, None, far, held=True) == []
+
+
 def test_a_robot_past_its_leash_may_still_come_back():
     """A body that coasted past the leash may take steps that bring its parent nearer,
     never ones that take it farther."""

@@ -29,7 +29,7 @@ from algorithms.exploration.entry import (
     TurnedBack,
     Withdraw,
 )
-from algorithms.exploration.explorer import Explorer
+from algorithms.exploration.explorer import CLEAR_BEHIND_M, NO_BACKING, Explorer
 from algorithms.exploration.modes import TERMINAL, TRANSITIONS, Mode
 from algorithms.exploration.leash import Leash
 from algorithms.navigation import NavEvent, NavigatorState
@@ -71,6 +71,9 @@ class Nav:
     def lane_bearings(self, bearings):
         return bearings
 
+    def carried(self, percept) -> None:
+        pass
+
     def arrive(self) -> None:
         self.state, self.arrived_angle = NavigatorState.AT_VERTEX, math.pi
         self.on_lane = self.in_corridor = self.room_to_turn = False
@@ -103,6 +106,7 @@ class Tied:
     """A tether and its connected exploration, as far as the explorer asks them."""
 
     me, parents, relay_trips, consulted, stops_part_way, mode = 0, (), 0, True, False, "explore"
+    calls_relay = False
 
     def __init__(self, mind: Mind) -> None:
         self.mind, self.children, self.sense, self.stall = mind, set(), 1, False
@@ -295,6 +299,68 @@ def test_a_relay_held_on_a_centre_on_its_way_withdraws_and_relays_there():
     r.tie.mode = "relay"
     assert r.step() is Mode.IDLE and Withdraw() in r.sent
     assert (Mode.ASKING, Mode.DECIDING) in r.moves
+
+
+def test_a_robot_leaving_that_calls_a_relay_gives_the_vertex_up_once_clear_of_its_centre():
+    """Its relay may need the centre it leaves: once it calls one (rule 6) and is
+    CLEAR_BEHIND_M out, a leaving robot tells the stations it left, short of its corridor;
+    nearer, or not calling, it keeps the vertex."""
+    r = asking(tied=True)
+    assert r.step(EntryGranted(True, ANGLE)) is Mode.LEAVING
+    r.on_lane(corridor=False)
+    r.nav.odometry.distance_m = CLEAR_BEHIND_M
+    assert r.step() is Mode.LEAVING and LeftVertex() not in r.sent  # not calling
+    r.tie.calls_relay = True
+    r.nav.odometry.distance_m = CLEAR_BEHIND_M - 0.01
+    assert r.step() is Mode.LEAVING and LeftVertex() not in r.sent  # too near
+    r.nav.odometry.distance_m = CLEAR_BEHIND_M
+    assert r.step() is Mode.ON_LANE and r.sent == [LeftVertex()]
+
+
+def test_a_robot_whose_hidden_parent_leaves_it_no_move_to_undo_stands_pinned():
+    """The leash's retrace with its trail spent and the parent still out of its ranging:
+    the robot stands as one its leash stopped, and tells its connected exploration it can
+    take no step at all (it neither retreats nor offers itself: rule 6)."""
+    r = asking(tied=True)
+    assert r.step(EntryGranted(True, ANGLE)) is Mode.LEAVING
+    r.on_lane(corridor=False)
+    calls = []
+    r.tie.after = lambda *args, **kwargs: calls.append((args, kwargs)) or []
+    r.tie.parents = (5,)  # a parent its ranging does not show
+    r.x.leash.forget()
+    command = r.x.step(Observation(0, r.t + DT_S, (math.nan,) * 3, (math.nan,) * 3,
+                                   (0.0, 0.0), beacon=None))
+    assert (command.v_m_s, command.omega_rad_s) == (0.0, 0.0)
+    (args, kwargs), = calls
+    assert args[1] is not None and args[2] is False and kwargs == {"pinned": True}
+
+
+def test_a_robot_on_its_way_in_to_a_centre_never_backs_out_when_its_parent_fades():
+    """On its lane a robot whose parent's link fades drives its last moves backwards; on
+    its way in to a vertex centre (the arrival's dead-reckoned sidestep, seek and spoke,
+    NO_BACKING) it stands pinned instead: resumed after a retrace, the arrival would end
+    off the centre."""
+    assert NavigatorState.ARRIVING in NO_BACKING and NavigatorState.ON_EDGE not in NO_BACKING
+
+    def faded_after_two_ticks_in(state: NavigatorState):
+        r = asking(tied=True)
+        r.step(EntryGranted(True, ANGLE))
+        r.on_lane()
+        assert r.step() is Mode.ON_LANE
+        r.tie.parents, r.nav.state = (5,), state
+        calls = []
+        r.tie.after = lambda *args, **kwargs: calls.append(kwargs) or []
+        linked = {5: SimpleNamespace(range_m=0.5, bearing_rad=math.pi)}
+        for detections in (linked, linked, linked, {}):
+            r.t += DT_S
+            command = r.x.step(Observation(0, r.t, (math.nan,) * 3, (math.nan,) * 3,
+                                           (0.0, 0.0), detections=detections, beacon=None))
+        return command, calls[-1]
+
+    command, kwargs = faded_after_two_ticks_in(NavigatorState.ON_EDGE)
+    assert command.v_m_s < 0.0 and kwargs == {}  # it backs its last move out
+    command, kwargs = faded_after_two_ticks_in(NavigatorState.ARRIVING)
+    assert (command.v_m_s, command.omega_rad_s) == (0.0, 0.0) and kwargs == {"pinned": True}
 
 
 def test_walking_back_from_the_area_it_leaves():

@@ -148,6 +148,21 @@ WAIT_BACKOFF_M = 0.04
 #: beyond touching (two body radii apart): its retrace and its U-turns run blind of the
 #: speed rule (:meth:`Explorer._in_the_way`).
 CLEARANCE_MARGIN_M = 0.03
+#: A tethered robot that calls a relay while it still holds the vertex it is leaving gives
+#: that vertex up once it has driven this far (m) from its centre (ours, for bodies): its
+#: relay may need the very centre (where an edge turns a corner, a wall fades its links
+#: as it reaches the corridor's mouth, about 0.3 m out, before it sees the corridor's
+#: walls). Edges meet at 45 degrees or more, so a robot 0.25 m out along one is at least
+#: 0.25 sin 45 = 0.18 m from any point of its neighbours' centre lines: more than two
+#: body radii (0.15 m) from a robot on the centre or on its way to it.
+CLEAR_BEHIND_M = 0.25
+#: Where a tethered robot never backs its moves out (the leash's retrace forgets its trail):
+#: on a vertex centre (it would scan off it) and on its way in to one. The arrival's
+#: sidestep, seek and spoke are dead-reckoned moves of a plan the navigator resumes by
+#: odometry; driven backwards and resumed, they end off the centre, where the robot finds
+#: no spoke and is lost. A robot whose parent's link fades there stands, pinned.
+NO_BACKING = frozenset({NavigatorState.ARRIVING, NavigatorState.SCANNING,
+                        NavigatorState.AT_VERTEX})
 
 
 class VertexCall(NamedTuple):
@@ -296,8 +311,10 @@ class Explorer(Controller):
     def _hear(self, now: int, observation: Observation, around, out: list[Message]) -> None:
         """Its connected exploration reads the radio; what rule 6 asks of vertex entry."""
         tied = [m for m in observation.inbox if m.sender != STATION]
-        # leaving a vertex (granted the next one) it adopts nobody: it would hold both
-        out += self.connected.hear(now, tied, around, willing=self.mode not in HOLDS_BEHIND)
+        # leaving a vertex (granted the next one) it adopts nobody, it would hold both;
+        # unless it relays there (a relay's last leg may end on the centre it leaves)
+        willing = self.mode not in HOLDS_BEHIND or self.connected.mode == RELAY
+        out += self.connected.hear(now, tied, around, willing=willing)
         if self.mode is Mode.WITHDRAWN and not self.tether.holds():
             self._enter(Mode.ASKING)  # free to go: ask again
             out.append(Message(self._asked, STATION))
@@ -319,13 +336,24 @@ class Explorer(Controller):
         wanted = self.leash.check(
             (command.v_m_s, command.omega_rad_s) if moving else None,
             (command.v_m_s * self.control_dt_s, 0.0), around, back=self.mode in RETURNING,
-            at_centre=self.nav.state in (NavigatorState.SCANNING, NavigatorState.AT_VERTEX))
+            at_centre=self.nav.state in NO_BACKING)
         if wanted is not None:
             command = Command(messages=command.messages)
         out = list(command.messages)
         out += self.connected.after(now, wanted, command.v_m_s != 0.0, around, self._held,
                                     self.leash.cut_on_this_way(self.mode in RETURNING))
+        self._give_up_behind(out)
         return command._replace(messages=tuple(out))
+
+    def _give_up_behind(self, out: list[Message]) -> None:
+        """Leaving a vertex, it calls a relay (rule 6): once ``CLEAR_BEHIND_M`` out, it
+        gives that vertex up (LeftVertex), so that the relay may take its centre; it never
+        backs into it again (its trail is forgotten)."""
+        if (self.mode is Mode.LEAVING and self.connected.calls_relay
+                and self.nav.odometry.distance_m - self._left_at_m >= CLEAR_BEHIND_M):
+            out.append(Message(LeftVertex(), STATION))
+            self._enter(Mode.ON_LANE)
+            self._forget_trail()
 
     def _set_out(self, observation: Observation, out: list[Message]) -> None:
         """Rule 6: it accepted a relay mission. On an edge its plan starts with the walk
@@ -348,13 +376,21 @@ class Explorer(Controller):
                  observation: Observation) -> Command:
         """A parent's link is gone (a wall came between them: the leash knows ranges, not
         walls): drive its last moves backwards until the link is back, then wait for a new
-        parent as if the leash had stopped it (on a vertex centre, at once: a robot backed
+        parent as if the leash had stopped it (so also on its leg with no move left to
+        undo, the link still gone; on a vertex centre it waits at once: a robot backed
         out of the centre it scans on would scan off it, find no beacon and stop). Its
         navigator counts these ticks on its odometry (:meth:`~algorithms.navigation.
         Navigator.carried`), so that its motion resumes from where the body is."""
         self.nav.carried(self._percept(observation))
-        move = self.leash.undo(around, self.mode in RETURNING, lambda vw: (-vw[0], -vw[1]),
+        back = self.mode in RETURNING
+        move = self.leash.undo(around, back, lambda vw: (-vw[0], -vw[1]),
                                may=lambda vw: not self._in_the_way(around, -vw[0]))
+        if move is None and self.mode in ON_LEG:  # nothing left to undo: the wall stops it
+            step = ((-1.0 if back else 1.0) * self.cruise_m_s * self.control_dt_s, 0.0)
+            out += self.connected.after(now, step, False, around, False,
+                                        self.leash.cut_on_this_way(back), pinned=True)
+            self._give_up_behind(out)
+            return Command(messages=tuple(out))
         if move is None:
             return self._stand(now, out, around)
         out.append(self.tether.beat(now, True, False, len(self.strategy.map_edges())))

@@ -100,7 +100,7 @@ TRANSITIONS: dict[Mode, dict[Mode, str]] = {
         Mode.ASKING: "no child to hold for (none, or all held by the world): it asks again",
         Mode.DECIDING: "EntryBlocked, or it sets out as a relay"},
     Mode.LEAVING: {
-        Mode.ON_LANE: "in its corridor: LeftVertex",
+        Mode.ON_LANE: "in its corridor, or calling a relay clear of the centre: LeftVertex",
         Mode.TURN_ASKED_LEAVING: "it must walk back, short of room to turn: TurnedBack"},
     Mode.ON_LANE: {
         Mode.DECIDING: "arrived at the vertex ahead",

@@ -9,7 +9,8 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   started from and the incidence angles at both ends), the leg it is on, and how far
   along it is.
 * **Offer.** A robot that is free (exploring, without children, and itself stuck or held
-  by the world as long, or idle at a vertex) floods ``RelayOffer``. (A robot held on a
+  by the world as long, or idle at a vertex; never one that can take no step at all, see
+  Retreat) floods ``RelayOffer``. (A robot held on a
   vertex centre before its leg began is back where it started at once: the world calls
   :meth:`ConnectedExplorer.arrived_back` without moving it.) A robot with a request of
   its own offers only to requesters with a smaller index, and then drops its request, so
@@ -36,7 +37,10 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   (nobody came) suspends its task and walks back to the root, where it waits in
   reserve: free to serve as a relay, and back to its own task once it has heard no
   request for ``RESUME_AFTER_UNITS``. A robot walking back to its task that gets stuck is
-  free to serve, and retreats again after as long.
+  free to serve, and retreats again after as long. A robot that can take no step at all
+  (a wall fades its parent's link, and it has no move left to undo: the leash,
+  :mod:`algorithms.exploration.leash`) never retreats: it keeps asking, since only a
+  relay in its ranging can free it.
 
 * **Held on the way.** A relay that the world holds on its way (a body ahead on its lane,
   a vertex area it may not enter yet, on a lane or on a vertex centre where it waits for
@@ -191,6 +195,7 @@ class ConnectedExplorer:
         self.idle = False
         self.stuck = 0  # ticks it wanted to step and the leash forbade it
         self.held = 0  # ticks it wanted to move and the world held it
+        self.pinned = False  # it could take no step at all in its last tick (:meth:`after`)
         self.under_way = False  # on an edge (the world has asked its direction since it left)
         self._waits = Waits.at(tether.ticks_per_unit)
         #: whether its last vertex call asked its strategy (else: it walked a plan)
@@ -247,8 +252,14 @@ class ConnectedExplorer:
         and holds, and offers itself to nobody."""
         self.mode, self.offer, self.request = RETIRED, None, None
 
+    @property
+    def calls_relay(self) -> bool:
+        """Whether it has wanted to step, and could not, long enough to call a relay."""
+        return self.stuck >= self._waits.recruit
+
     def _free(self) -> bool:
-        if self.tether.children or self.offer is not None or self.tether.request is not None:
+        if (self.tether.children or self.offer is not None or self.tether.request is not None
+                or self.pinned):
             return False
         stuck = max(self.stuck, self.held) >= self._waits.recruit
         return (self.mode == RESERVE or (self.mode == EXPLORE and (stuck or self.idle))
@@ -395,16 +406,20 @@ class ConnectedExplorer:
 
     # ------------------------------------------------------------------ end of tick
     def after(self, tick: int, wanted: Sequence[float] | None, moved: bool,
-              around: Mapping, held: bool = False, cut: Collection = ()) -> list[Message]:
+              around: Mapping, held: bool = False, cut: Collection = (),
+              pinned: bool = False) -> list[Message]:
         """``wanted``: the step the leash forbade it (None if none); ``held``: it wanted to
         move and the world held it (a body ahead on its lane, a vertex not yet entered);
-        ``cut``: parents whose link that step would lose to a wall (rule 4's ``cut``)."""
+        ``cut``: parents whose link that step would lose to a wall (rule 4's ``cut``);
+        ``pinned``: it can take no step at all, back included (a wall fades its parent's
+        link and no move is left to undo), so it never retreats: it keeps asking."""
         self._tick = tick
         waits = self._waits
-        out = self.tether.ask(tick, wanted, around, cut)
+        out = self.tether.ask(tick, wanted, around, cut, held)
         blocked = wanted is not None and not self.tether.children
         self.stuck = self.stuck + 1 if blocked else 0
         self.held = self.held + 1 if held else 0
+        self.pinned = pinned
         if self.awaiting_until is not None and (not self.stuck or tick >= self.awaiting_until):
             if self.stuck:  # its relay did not come: ask again, then retreat as before
                 self.stuck = waits.recruit
@@ -426,7 +441,8 @@ class ConnectedExplorer:
             self._become_relay_here()  # held on its way, on an edge or on a centre
         if self.mode == RELAY:
             self._relay_tick(tick)
-        if self.mode in (EXPLORE, RETURN) and self.stuck >= waits.retreat and not awaiting:
+        if (self.mode in (EXPLORE, RETURN) and self.stuck >= waits.retreat and not awaiting
+                and not pinned):
             if self.task is None:
                 self.task = (tuple(self.route), self.leg, self.progress)
             self.mode, self.request = RETREAT, None
@@ -436,7 +452,8 @@ class ConnectedExplorer:
             self.mode = RETURN
             self._head_for(*self.task)
         out.append(self.tether.beat(tick, moved or not self._settled(), self.progressed,
-                                    len(self.mind.map_edges()), held))
+                                    len(self.mind.map_edges()), held,
+                                    wanted is not None and not self.tether.holds()))
         self.progressed = False
         return out
 

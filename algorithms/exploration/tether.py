@@ -47,7 +47,11 @@ rule below is ours (the papers give none for this combination):
    neighbour fewer hops from the base than its parent is (so that relays are released),
    and one whose parent has gone from its ranging (a wall came between them: the leash
    knows ranges, not walls) asks any still neighbour in range; a robot with children
-   may ask the base itself, which descends from nobody.
+   may ask the base itself, which descends from nobody. A robot that the world holds
+   (rule 2) asks any still neighbour in range to replace a parent whose beat says its
+   leash stopped it: that parent, left without children, may then adopt it and step on
+   (on bodies a robot stopped at a corridor's mouth, its child waiting on the centre
+   behind it, would otherwise hold for the child that waits for it).
    The asked robot adds it to its children at once, which makes it hold, and answers
    ``Adopted``. The asker does not move while its request is out and switches parent only
    when the answer comes and the new parent is still in range. While its own request is
@@ -94,9 +98,10 @@ BASE = "base"
 class Beat(NamedTuple):
     """Sent by every robot every tick: its parents, its hops from the base, whether it
     stood still in its last tick, the last tick at which it knows an exploring robot
-    reached a vertex, the most edges it knows a robot's map to hold (rule 5), and
-    whether the world held it in its last tick (it wanted to move and waits for a
-    vertex area or a lane: rule 2's exception)."""
+    reached a vertex, the most edges it knows a robot's map to hold (rule 5), whether
+    the world held it in its last tick (it wanted to move and waits for a vertex area
+    or a lane: rule 2's exception), and whether its leash forbade its step in its last
+    tick (rule 4: a child the world holds lets such a parent go)."""
 
     parents: tuple
     depth: int
@@ -104,6 +109,7 @@ class Beat(NamedTuple):
     last_progress: int
     known_edges: int
     held: bool = False
+    stuck: bool = False
 
 
 class Adopt(NamedTuple):
@@ -202,14 +208,18 @@ class Tether:
         return any(c not in self.heard or not self.heard[c].held for c in self.children)
 
     def ask(self, tick: int, step: Sequence[float] | None,
-            around: Mapping[Hashable, Sequence[float]], cut: Collection = ()) -> list[Message]:
+            around: Mapping[Hashable, Sequence[float]], cut: Collection = (),
+            held: bool = False) -> list[Message]:
         """Rule 4, asking side: after a tick in which this robot wanted to take ``step``
         (None: it wanted to stay) and did not, or could do with a parent nearer the base.
         With two parents it replaces one at a time: the first that forbids the step, else
         the one farthest from the base (in hops). ``cut``: parents whose link the step
         would lose for another reason than range (a wall, as the robot found). A parent
         missing from ``around`` (its link lost, or fading: a wall came between) blocks
-        whatever the step, even staying: any still neighbour in range may replace it."""
+        whatever the step, even staying: any still neighbour in range may replace it.
+        ``held``: the world held it in this tick; then a parent whose beat says its leash
+        stopped it may be replaced by any still neighbour in range, so that the parent,
+        left without children, may adopt it or call a relay."""
         if self.request is not None:
             return []
         deepest = max(self.parents, key=lambda q: self._depth_of(q))
@@ -219,12 +229,15 @@ class Tether:
             return []
         blocking = [q for q in self.parents if q not in around or step is not None
                     and (q in cut or not self._within(step, around[q]))]
+        stopped = [q for q in self.parents if held and q in self.heard and self.heard[q].stuck]
         best = None
         for r, beat in self.heard.items():
             if r in self.parents or not beat.still or r not in around:
                 continue
             if blocking and self._within(step or (0.0, 0.0), around[r]):
                 replaced = blocking[0]
+            elif stopped and self._within((0.0, 0.0), around[r]):
+                replaced = stopped[0]
             elif (beat.depth < self._depth_of(deepest) and self._within((0.0, 0.0), around[r])
                   and (step is None or deepest in blocking or self._within(step, around[r]))):
                 replaced = deepest  # never a parent that allows the step for one that forbids it
@@ -238,15 +251,16 @@ class Tether:
         return self._request(best[1], tick, best[2])
 
     def beat(self, tick: int, moved: bool, progressed: bool, known_edges: int,
-             held: bool = False) -> Message:
+             held: bool = False, stuck: bool = False) -> Message:
         """Rule 5's gossip, and what the others need of rules 2 and 4: ``progressed``
         when this robot reached a vertex while exploring in this tick, ``known_edges``
-        the edges of its map, ``held`` when the world held it in this tick."""
+        the edges of its map, ``held`` when the world held it in this tick, ``stuck``
+        when its leash forbade its step in this tick."""
         if progressed:
             self.last_progress = tick
         self.known_edges = max(self.known_edges, known_edges)
         return Message(Beat(self.parents, self.depth, not moved, self.last_progress,
-                            self.known_edges, held))
+                            self.known_edges, held, stuck))
 
     def stalled(self, tick: int) -> bool:
         """Rule 5: no exploring arrival known anywhere for the patience it states."""
