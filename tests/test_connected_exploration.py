@@ -161,6 +161,21 @@ def test_a_robot_held_by_the_world_as_long_as_a_stuck_one_offers_itself():
     assert offers(robot.hear(waits.recruit + 2, [_wanted(3)], {})) == []
 
 
+def test_a_free_robot_never_offers_itself_to_its_own_parent():
+    """Rule 6: a requester takes its relay for a parent, which its own child, hanging from
+    it, cannot be (a cycle), and on bodies the child's walk to it leads past it on its
+    lane. Free (held as long as a stuck robot), the child offers itself to any other
+    requester, never to its parent."""
+    robot = ConnectedExplorer(0, make_minds("incidence-dfs", 1, None)[0],
+                              Tether(0, range_m=1.0, parents=(2,)))
+    waits = robot._waits
+    for tick in range(1, waits.recruit + 1):
+        robot.after(tick, None, False, {}, held=True)
+    offers = lambda out: [m.payload for m in out if isinstance(m.payload, RelayOffer)]
+    assert offers(robot.hear(waits.recruit + 1, [_wanted(2)], {})) == []
+    assert offers(robot.hear(waits.recruit + 2, [_wanted(1)], {})) == [RelayOffer(1, 1, 0)]
+
+
 def test_a_relay_held_on_its_way_relays_from_there():
     """A relay held on its way as long as a stuck one becomes a relay there, on its edge
     or on a vertex centre where it waits for the next vertex; held for less, it goes on."""
@@ -230,18 +245,24 @@ def test_a_robot_that_can_take_no_step_keeps_asking_and_never_retreats_or_offers
     assert stuck_for(False)[0].mode == RETREAT
 
 
-def test_a_beat_says_stuck_only_when_the_leash_stopped_it():
-    """Rule 4's ``stuck``: a robot whose leash forbade its step says so; one that holds for
-    a child on the move does not (a child the world holds would otherwise leave it for a
-    neighbour that is asking that child at the same time, and crossing requests refuse
-    each other for good)."""
+def test_a_robot_is_stuck_when_its_leash_stops_it_not_when_it_holds_for_a_child():
+    """Rules 2, 4 and 6: a robot whose leash forbade its step counts the tick stuck (it
+    calls a relay, then retreats) and its beat says so; one that holds for a child on the
+    move does neither (a child the world holds would otherwise leave it for a neighbour
+    that is asking that child at the same time, and crossing requests refuse each other
+    for good). A parent whose every child the world holds may step, so its leash stops
+    it as any robot's: it counts stuck."""
     robot = ConnectedExplorer(1, make_minds("incidence-dfs", 1, None)[0], Tether(1, range_m=1.0))
     beat = lambda out: [m.payload for m in out if isinstance(m.payload, Beat)][-1]
-    assert beat(robot.after(1, (0.1, 0.0), False, {})).stuck
+    assert beat(robot.after(1, (0.1, 0.0), False, {})).stuck and robot.stuck == 1
     robot.tether.hear(2, [Message(Adopt(), to=1, sender=2)], {2: (0.5, 0.0)})
     assert robot.tether.holds()
-    assert not beat(robot.after(2, (0.1, 0.0), False, {})).stuck
+    assert not beat(robot.after(2, (0.1, 0.0), False, {})).stuck and robot.stuck == 0
     assert not beat(robot.after(3, None, False, {})).stuck
+    robot.tether.hear(4, [Message(Beat((1,), 2, True, 0, 0, held=True), sender=2)],
+                      {2: (0.5, 0.0)})
+    assert not robot.tether.holds()
+    assert beat(robot.after(4, (0.1, 0.0), False, {})).stuck and robot.stuck == 1
 
 
 # ---------------------------------------------------------------------------- the tether
@@ -536,6 +557,17 @@ def test_embodied_a_parent_makes_way_for_a_child_waiting_for_its_vertex():
     result = embodied("fig9", 5, 2.5, seed=1, connectivity="connected", speed_m_s=0.1)
     assert result.completed and result.map_correct
     assert result.collisions == 0 and result.cut_ticks == 0 and not result.stopped_robots
+
+
+@pytest.mark.slow  # tests/test_explorer_states.py holds NO_BACKING without physics
+def test_embodied_an_arrival_is_never_backed_out():
+    """random-tree:10:2, 3 robots at 1.5 m, seed 1, 10 cm/s: R3's parent's link fades while
+    R3 sidesteps onto a vertex's centre line, at 320 s. It stands there (NO_BACKING)
+    until a new parent is in range; backed out and resumed, its arrival ended 0.27 m off
+    the centre, it found no spoke and was lost. The team completes the true map."""
+    result = embodied("random-tree:10:2", 3, 1.5, seed=1, speed_m_s=0.1)
+    assert result.completed and result.map_correct and not result.stopped_robots
+    assert result.collisions == 0 and result.cut_ticks == 0
 
 
 @pytest.mark.slow

@@ -10,7 +10,9 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   along it is.
 * **Offer.** A robot that is free (exploring, without children, and itself stuck or held
   by the world as long, or idle at a vertex; never one that can take no step at all, see
-  Retreat) floods ``RelayOffer``. (A robot held on a
+  Retreat) floods ``RelayOffer``, to any requester but its own parent (the requester
+  takes its relay for a parent, which a robot hanging from it cannot be; on bodies its
+  walk there leads past the requester on its lane). (A robot held on a
   vertex centre before its leg began is back where it started at once: the world calls
   :meth:`ConnectedExplorer.arrived_back` without moving it.) A robot with a request of
   its own offers only to requesters with a smaller index, and then drops its request, so
@@ -33,8 +35,8 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   ``RELEASE_UNITS`` (its child went on, or came back and re-attached nearer the base), or
   was never adopted within ``RELAY_PATIENCE_UNITS``, it goes back the same way and resumes
   its own task where it left it.
-* **Retreat.** An exploring robot stuck without children for ``RETREAT_AFTER_UNITS``
-  (nobody came) suspends its task and walks back to the root, where it waits in
+* **Retreat.** An exploring robot stuck with no child to hold for (none, or each one
+  held by the world: rule 2 lets it step) for ``RETREAT_AFTER_UNITS`` (nobody came) suspends its task and walks back to the root, where it waits in
   reserve: free to serve as a relay, and back to its own task once it has heard no
   request for ``RESUME_AFTER_UNITS``. A robot walking back to its task that gets stuck is
   free to serve, and retreats again after as long. A robot that can take no step at all
@@ -193,7 +195,9 @@ class ConnectedExplorer:
         self.backwards = False
         self.progress = 0.0
         self.idle = False
-        self.stuck = 0  # ticks it wanted to step and the leash forbade it
+        #: ticks it wanted to step and the leash forbade it (not holding for a child: a
+        #: parent whose children the world all holds may step, rule 2, so it counts too)
+        self.stuck = 0
         self.held = 0  # ticks it wanted to move and the world held it
         self.pinned = False  # it could take no step at all in its last tick (:meth:`after`)
         self.under_way = False  # on an edge (the world has asked its direction since it left)
@@ -266,8 +270,8 @@ class ConnectedExplorer:
                 or (self.mode == RETURN and stuck))
 
     def _consider(self, tick: int, wanted: RelayWanted, out: list[Message]) -> None:
-        if not self._free():
-            return
+        if not self._free() or wanted.requester in self.tether.parents:
+            return  # never its parent's relay: its parent would take it for a parent
         if self.request is not None:
             if wanted.requester > self.index:
                 return
@@ -416,7 +420,7 @@ class ConnectedExplorer:
         self._tick = tick
         waits = self._waits
         out = self.tether.ask(tick, wanted, around, cut, held)
-        blocked = wanted is not None and not self.tether.children
+        blocked = wanted is not None and not self.tether.holds()
         self.stuck = self.stuck + 1 if blocked else 0
         self.held = self.held + 1 if held else 0
         self.pinned = pinned
@@ -452,8 +456,7 @@ class ConnectedExplorer:
             self.mode = RETURN
             self._head_for(*self.task)
         out.append(self.tether.beat(tick, moved or not self._settled(), self.progressed,
-                                    len(self.mind.map_edges()), held,
-                                    wanted is not None and not self.tether.holds()))
+                                    len(self.mind.map_edges()), held, blocked))
         self.progressed = False
         return out
 
