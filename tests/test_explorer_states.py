@@ -342,7 +342,7 @@ def test_a_robot_on_its_way_in_to_a_centre_never_backs_out_when_its_parent_fades
     off the centre."""
     assert NavigatorState.ARRIVING in NO_BACKING and NavigatorState.ON_EDGE not in NO_BACKING
 
-    def faded_after_two_ticks_in(state: NavigatorState):
+    def faded_after_three_ticks_in(state: NavigatorState):
         r = asking(tied=True)
         r.step(EntryGranted(True, ANGLE))
         r.on_lane()
@@ -357,9 +357,9 @@ def test_a_robot_on_its_way_in_to_a_centre_never_backs_out_when_its_parent_fades
                                            (0.0, 0.0), detections=detections, beacon=None))
         return command, calls[-1]
 
-    command, kwargs = faded_after_two_ticks_in(NavigatorState.ON_EDGE)
+    command, kwargs = faded_after_three_ticks_in(NavigatorState.ON_EDGE)
     assert command.v_m_s < 0.0 and kwargs == {}  # it backs its last move out
-    command, kwargs = faded_after_two_ticks_in(NavigatorState.ARRIVING)
+    command, kwargs = faded_after_three_ticks_in(NavigatorState.ARRIVING)
     assert (command.v_m_s, command.omega_rad_s) == (0.0, 0.0) and kwargs == {"pinned": True}
 
 

@@ -351,9 +351,7 @@ class Explorer(Controller):
         backs into it again (its trail is forgotten)."""
         if (self.mode is Mode.LEAVING and self.connected.calls_relay
                 and self.nav.odometry.distance_m - self._left_at_m >= CLEAR_BEHIND_M):
-            out.append(Message(LeftVertex(), STATION))
-            self._enter(Mode.ON_LANE)
-            self._forget_trail()
+            self._leave_behind(out)
 
     def _set_out(self, observation: Observation, out: list[Message]) -> None:
         """Rule 6: it accepted a relay mission. On an edge its plan starts with the walk
@@ -473,13 +471,17 @@ class Explorer(Controller):
         up is one it never backs into: :meth:`_retrace`)."""
         nav = self.nav
         if self.mode in HOLDS_BEHIND and nav.in_corridor:  # clear of the vertex it left
-            out.append(Message(LeftVertex(), STATION))
-            self._enter(Mode.ON_LANE if self.mode is Mode.LEAVING else Mode.TURN_ASKED)
-            self._forget_trail()
+            self._leave_behind(out)
         if self.mode is Mode.WALKING_BACK_UNTOLD and nav.on_lane:  # out of the area ahead
             out.append(Message(TurnedBack(from_lane=True), STATION))
             self._enter(Mode.WALKING_BACK)
             self._forget_trail()
+
+    def _leave_behind(self, out: list[Message]) -> None:
+        """It gives up the vertex it left (LeftVertex), and never backs into it again."""
+        out.append(Message(LeftVertex(), STATION))
+        self._enter(Mode.ON_LANE if self.mode is Mode.LEAVING else Mode.TURN_ASKED)
+        self._forget_trail()
 
     def _forget_trail(self) -> None:
         if self.leash is not None:

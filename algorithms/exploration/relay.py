@@ -36,9 +36,10 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   was never adopted within ``RELAY_PATIENCE_UNITS``, it goes back the same way and resumes
   its own task where it left it.
 * **Retreat.** An exploring robot stuck with no child to hold for (none, or each one
-  held by the world: rule 2 lets it step) for ``RETREAT_AFTER_UNITS`` (nobody came) suspends its task and walks back to the root, where it waits in
-  reserve: free to serve as a relay, and back to its own task once it has heard no
-  request for ``RESUME_AFTER_UNITS``. A robot walking back to its task that gets stuck is
+  held by the world: rule 2 lets it step) for ``RETREAT_AFTER_UNITS`` (nobody came)
+  suspends its task and walks back to the root, where it waits in reserve: free to
+  serve as a relay, and back to its own task once it has heard no request for
+  ``RESUME_AFTER_UNITS``. A robot walking back to its task that gets stuck is
   free to serve, and retreats again after as long. A robot that can take no step at all
   (a wall fades its parent's link, and it has no move left to undo: the leash,
   :mod:`algorithms.exploration.leash`) never retreats: it keeps asking, since only a
