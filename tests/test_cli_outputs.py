@@ -9,6 +9,7 @@ import subprocess
 import pytest
 
 import mjswarm.experiments.exploration
+from mjswarm.arena import load_arena
 from mjswarm.cli import main
 from mjswarm.outputs.recording import rerun_command
 
@@ -126,3 +127,18 @@ def test_one_numbering_in_the_summary(capsys):
     assert main(["explore", "--world", "graph", "--arena", "fig9", "--robots", "2"]) == 0
     out = capsys.readouterr().out
     assert "R1 declared completion at v8; makespan 8 steps" in out
+
+
+def test_a_stall_summary_counts_robots_and_relay_trips_in_their_number():
+    """One robot, one relay trip: singular; two: plural."""
+    from mjswarm.cli.explore import summary
+    from mjswarm.experiments.runs import run_exploration
+
+    result = run_exploration(load_arena("arena1"), 2, world="graph", radio_range_m=1.5,
+                             connectivity="connected")
+    d = result.to_dict()
+    d["world"] = "graph"
+    assert d["stalled"] and d["robots_needed"] == 2 and d["relay_trips"] == 1
+    assert "though 2 robots could reach" in summary(d) and "1 relay trip;" in summary(d)
+    d["robots_needed"], d["relay_trips"] = 1, 2
+    assert "though 1 robot could reach" in summary(d) and "2 relay trips;" in summary(d)

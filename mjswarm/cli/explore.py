@@ -369,8 +369,9 @@ def summary(result: dict) -> str:
                          f"{result['robots_needed']} robots to the base at this range; add "
                          f"robots or range")
         elif result.get("stalled"):
+            needed = result["robots_needed"]
             lines.append(f"stalled: no robot reached a new vertex for a while (the "
-                         f"tether's rule 5), though {result['robots_needed']} robots could "
+                         f"tether's rule 5), though {needed} robot{'s' * (needed != 1)} could "
                          f"reach every edge at this range: the team did not find the way "
                          f"(its relays could not get where they were needed); a longer "
                          f"range needs fewer relays")
@@ -380,7 +381,8 @@ def summary(result: dict) -> str:
             f"{' (walls block)' if result.get('radio_model') == 'walls' else ''}"
             f"{' (range alone)' if result.get('radio_model') == 'open' else ''}, "
             f"connectivity {result['connectivity']}: "
-            f"{result['messages']} messages, {result['relay_trips']} relay trips; every "
+            f"{result['messages']} messages, {result['relay_trips']} relay "
+            f"trip{'s' * (result['relay_trips'] != 1)}; every "
             f"robot reached the base in {100 * result['connected_share']:.1f} % of the "
             f"ticks, the team with the base was biconnected in "
             f"{100 * result['biconnected_share']:.1f} %")
