@@ -13,7 +13,7 @@ from algorithms.exploration.tether import (BASE, STALL_TIME_UNITS, STALL_UNITS_P
                                            Adopt, Adopted, Beat, Tether, docked,
                                            initial_parents)
 from algorithms.exploration.relay import (RELAY, RETURN, TRANSIT, ConnectedExplorer, Flooder,
-                                          RelayOffer, RelayWanted, Waits)
+                                          RelayAccepted, RelayOffer, RelayWanted, Waits)
 from algorithms.exploration.explorer import Explorer
 from algorithms.exploration.leash import Leash
 from algorithms.robot import Message
@@ -193,11 +193,65 @@ def test_a_relay_held_on_its_way_relays_from_there():
         assert robot.mode == RELAY
 
 
+def test_a_relay_counts_its_wait_on_the_way_from_its_acceptance():
+    """A robot that vertex entry held long enough to offer itself sets out once accepted:
+    held one more tick where it stood, it is still in transit (only a wait on its way
+    makes it relay from there, and that wait starts with the trip)."""
+    robot = ConnectedExplorer(0, make_minds("incidence-dfs", 1, None)[0], Tether(0, range_m=1.0))
+    recruit = robot._waits.recruit
+    for tick in range(1, recruit + 1):
+        robot.after(tick, None, False, {}, held=True)
+    offer = [m.payload for m in robot.hear(recruit + 1, [_wanted(1)], {})
+             if isinstance(m.payload, RelayOffer)]
+    assert offer == [RelayOffer(1, 1, 0)]
+    robot.hear(recruit + 2, [Message(RelayAccepted(1, 1, 0), sender=1)], {})
+    assert robot.mode == TRANSIT
+    for tick in range(recruit + 2, 2 * recruit + 1):
+        robot.after(tick, None, False, {}, held=True)
+        assert robot.mode == TRANSIT
+    robot.after(2 * recruit + 1, None, False, {}, held=True)
+    assert robot.mode == RELAY
+
+
+def test_a_relay_whose_children_the_world_holds_goes_back_after_its_patience():
+    """Rule 6's release: a relay holds while a child of its is on the move; once the world
+    has held every child of its for RELAY_PATIENCE_UNITS (a child waiting, say, for the
+    very vertex the relay stands on) it goes back, and a child that moves meanwhile
+    starts that wait anew."""
+    robot = ConnectedExplorer(1, make_minds("incidence-dfs", 1, None)[0], Tether(1, range_m=1.0))
+    robot.task = ((), None, 0.0)
+    robot._become_relay_here()
+    near = {2: (0.5, 0.0)}
+    child = lambda tick, held: robot.tether.hear(
+        tick, [Message(Beat((1,), 2, True, 0, 0, held=held), sender=2)], near)
+    patience = robot._waits.patience
+    tick = 0
+    for tick in range(1, 3 * patience):  # a child on the move: it relays on
+        child(tick, held=False)
+        robot.after(tick, None, False, near)
+    assert robot.mode == RELAY
+    start = tick + 1
+    for tick in range(start, start + patience // 2):
+        child(tick, held=True)
+        robot.after(tick, None, False, near)
+    child(tick + 1, held=False)  # it moved: the wait starts anew
+    robot.after(tick + 1, None, False, near)
+    start = tick + 2
+    for tick in range(start, start + patience):
+        child(tick, held=True)
+        robot.after(tick, None, False, near)
+        assert robot.mode == RELAY
+    child(start + patience, held=True)
+    robot.after(start + patience, None, False, near)
+    assert robot.mode == RETURN
+
+
 def test_a_requester_awaits_the_relay_it_accepted():
     """Rule 6: once it accepted an offer, a requester stuck at its leash asks nobody else
     and does not retreat while its relay may still be on its way (the offer's timeout and
     JOURNEY_UNITS_PER_LEG per leg of its route); then it asks again, and retreats as
-    before. Moving on ends the wait."""
+    before. Meanwhile it offers itself to nobody: its relay heads for where it stands.
+    Moving on ends the wait."""
     from algorithms.exploration.relay import EXPLORE, JOURNEY_UNITS_PER_LEG, RETREAT, Leg
 
     robot = ConnectedExplorer(1, make_minds("incidence-dfs", 1, None)[0], Tether(1, range_m=1.0))
@@ -214,6 +268,8 @@ def test_a_requester_awaits_the_relay_it_accepted():
         tick += 1
         assert wanted(robot.after(tick, (0.1, 0.0), False, {})) == []
         assert robot.mode == EXPLORE
+    assert robot.calls_relay and not [m for m in robot.hear(tick, [_wanted(0)], {})
+                                      if isinstance(m.payload, RelayOffer)]
     tick += 1
     assert wanted(robot.after(tick, (0.1, 0.0), False, {}))  # its relay did not come
     while robot.mode == EXPLORE:

@@ -10,7 +10,7 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   along it is.
 * **Offer.** A robot that is free (exploring, without children, and itself stuck or held
   by the world as long, or idle at a vertex; never one that can take no step at all, see
-  Retreat) floods ``RelayOffer``, to any requester but its own parent (the requester
+  Retreat, nor one that awaits a relay of its own, see Accept) floods ``RelayOffer``, to any requester but its own parent (the requester
   takes its relay for a parent, which a robot hanging from it cannot be; on bodies its
   walk there leads past the requester on its lane). (A robot held on a
   vertex centre before its leg began is back where it started at once: the world calls
@@ -23,8 +23,9 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   ``OFFER_TIMEOUT_UNITS`` plus ``JOURNEY_UNITS_PER_LEG`` per leg of its route (the
   relay's way to it, at most back to the root and out again), or until it moves on.
   (Asking again at once, as a requester still stuck would, recruits every free robot
-  in as many ticks, and one that retreats before its relay arrives leaves it waiting
-  for nobody: on bodies, where relays queue for vertex areas, a livelock.)
+  in as many ticks, and one that retreats, or sets out as another's relay, before its
+  relay arrives leaves it waiting for nobody: on bodies, where relays queue for vertex
+  areas, a livelock.)
 * **Transit.** The relay suspends its own task (its strategy is not asked anything and no
   beacon is written until it resumes), goes back to the last vertex where its route and the
   requester's agree, then along the requester's route and leg, and stops where the
@@ -34,7 +35,11 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
 * **Release.** A relay holds while it has children. Once it has had none for
   ``RELEASE_UNITS`` (its child went on, or came back and re-attached nearer the base), or
   was never adopted within ``RELAY_PATIENCE_UNITS``, it goes back the same way and resumes
-  its own task where it left it.
+  its own task where it left it. So it does too once the world has held every child of
+  its for ``RELAY_PATIENCE_UNITS``: on bodies a relay on a vertex centre is in the way
+  of a child that walks back through that vertex, and neither would ever move (``tri:2x3``,
+  four robots at 2 m). Going back, it steps only within its held children's leash
+  (rule 2) and stands again as soon as one of them moves.
 * **Retreat.** An exploring robot stuck with no child to hold for (none, or each one
   held by the world: rule 2 lets it step) for ``RETREAT_AFTER_UNITS`` (nobody came)
   suspends its task and walks back to the root, where it waits in reserve: free to
@@ -215,6 +220,7 @@ class ConnectedExplorer:
         self.task: tuple[tuple[Leg, ...], Leg | None, float] | None = None
         self.relay_since = 0
         self.had_child_at: int | None = None
+        self.children_held_since: int | None = None  # tick since every child is held
         self.progressed = False
         self._root: Hashable | None = None  # the root's beacon id
         self._tick = 0
@@ -264,8 +270,8 @@ class ConnectedExplorer:
 
     def _free(self) -> bool:
         if (self.tether.children or self.offer is not None or self.tether.request is not None
-                or self.pinned):
-            return False
+                or self.pinned or self.awaiting_until is not None):
+            return False  # one awaiting its own relay stays where that relay heads for
         stuck = max(self.stuck, self.held) >= self._waits.recruit
         return (self.mode == RESERVE or (self.mode == EXPLORE and (stuck or self.idle))
                 or (self.mode == RETURN and stuck))
@@ -293,7 +299,8 @@ class ConnectedExplorer:
         if self.task is None:  # exploring: suspend the task (else it is suspended already)
             self.task = (tuple(self.route), self.leg, self.progress)
         self._head_for(w.route, w.leg, max(0.0, w.progress - self.spacing))
-        self.mode, self.stuck, self.idle, self.stop_at = TRANSIT, 0, False, None
+        # its waits count from here: held as long before its trip, it is not held on its way
+        self.mode, self.stuck, self.held, self.idle, self.stop_at = TRANSIT, 0, 0, False, None
         self.relay_trips += 1
 
     # ------------------------------------------------------------------ at a vertex
@@ -406,7 +413,7 @@ class ConnectedExplorer:
 
     def _become_relay_here(self) -> Decision:
         self.mode, self.stop_at, self.plan = RELAY, None, []
-        self.relay_since, self.had_child_at = self._tick, None
+        self.relay_since, self.had_child_at, self.children_held_since = self._tick, None, None
         return IDLE
 
     # ------------------------------------------------------------------ end of tick
@@ -472,8 +479,14 @@ class ConnectedExplorer:
     def _relay_tick(self, tick: int) -> None:
         if self.tether.children:
             self.had_child_at = tick
-            return
-        if self.had_child_at is None:
+            if self.tether.holds():  # a child on the move
+                self.children_held_since = None
+                return
+            if self.children_held_since is None:
+                self.children_held_since = tick
+            if tick - self.children_held_since < self._waits.patience:
+                return  # every child held by the world, for a while yet: it still relays
+        elif self.had_child_at is None:
             if tick - self.relay_since < self._waits.patience:
                 return
         elif tick - self.had_child_at < self._waits.release:
