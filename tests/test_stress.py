@@ -57,7 +57,7 @@ def test_table_counts_what_it_ran():
     assert "| `narrow-fan` | 1 | 1 | 1 | 0 | 0 |" in text
 
 
-#: Dense teams at the top speed, one robot for every 5 edges, where a robot on its lane
+#: Dense teams at the top speed, one robot for every 4 to 7 edges, where a robot on its lane
 #: could stop for good (speed rule, beta = 0) for one standing on the centre of the vertex
 #: beyond the next, which waits for the vertex the first holds. The rule takes bearings
 #: in the lane's frame (the navigator's lane_bearings), so a nose turned a few degrees off

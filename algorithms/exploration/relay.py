@@ -10,13 +10,13 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
   along it is.
 * **Offer.** A robot that is free (exploring, without children, and itself stuck or held
   by the world as long, or idle at a vertex; never one that can take no step at all, see
-  Retreat, nor one that awaits a relay of its own, see Accept) floods ``RelayOffer``, to any requester but its own parent (the requester
-  takes its relay for a parent, which a robot hanging from it cannot be; on bodies its
-  walk there leads past the requester on its lane). (A robot held on a
-  vertex centre before its leg began is back where it started at once: the world calls
-  :meth:`ConnectedExplorer.arrived_back` without moving it.) A robot with a request of
-  its own offers only to requesters with a smaller index, and then drops its request, so
-  one of two stuck robots always serves the other.
+  Retreat, nor one that awaits a relay of its own, see Accept) floods ``RelayOffer``, to
+  any requester but its own parent (the requester takes its relay for a parent, which a
+  robot hanging from it cannot be; on bodies its walk there leads past the requester on
+  its lane). (A robot held on a vertex centre before its leg began is back where it
+  started at once: the world calls :meth:`ConnectedExplorer.arrived_back` without moving
+  it.) A robot with a request of its own offers only to requesters with a smaller index,
+  and then drops its request, so one of two stuck robots always serves the other.
 * **Accept.** The requester takes the first offer (the lowest index among those of one
   tick) and floods ``RelayAccepted``; other offers lapse after ``OFFER_TIMEOUT_UNITS``.
   It then awaits that relay: it neither asks again nor retreats for
@@ -35,11 +35,11 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
 * **Release.** A relay holds while it has children. Once it has had none for
   ``RELEASE_UNITS`` (its child went on, or came back and re-attached nearer the base), or
   was never adopted within ``RELAY_PATIENCE_UNITS``, it goes back the same way and resumes
-  its own task where it left it. So it does too once the world has held every child of
-  its for ``RELAY_PATIENCE_UNITS``: on bodies a relay on a vertex centre is in the way
-  of a child that walks back through that vertex, and neither would ever move (``tri:2x3``,
-  four robots at 2 m). Going back, it steps only within its held children's leash
-  (rule 2) and stands again as soon as one of them moves.
+  its own task where it left it. It goes back too once the world has held every child
+  of its for ``RELAY_PATIENCE_UNITS``: on bodies a relay on a vertex centre is in the way
+  of a child that walks back through that vertex, and neither would ever move
+  (``tri:2x3``, four robots at 2 m). Going back, it steps only within its held
+  children's leash (rule 2) and stands again as soon as one of them moves.
 * **Retreat.** An exploring robot stuck with no child to hold for (none, or each one
   held by the world: rule 2 lets it step) for ``RETREAT_AFTER_UNITS`` (nobody came)
   suspends its task and walks back to the root, where it waits in reserve: free to
