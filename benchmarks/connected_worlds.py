@@ -54,14 +54,19 @@ GRID = [(arena, k, range_m, seed, speed)
 
 def outcome(r) -> str:
     """Completed, or the verdict (infeasible, stalled) with the share of the edges
-    explored and the robots the arena needs."""
+    explored and the robots the arena needs; a run that reached its time limit with the
+    share of the edges its robots had traversed."""
+    from mjswarm.arena import load_arena
+
     if r.completed:
         return "completed"
     reason = getattr(r, "reason", None) or getattr(r, "ended_because", "")
     if "explored " in reason:
         explored = reason.split("explored ")[1].split(";")[0]
         return f"{reason.split(' with ')[0]}, {explored}, needs {r.robots_needed}"
-    return reason or "not completed"
+    traversed = {tuple(sorted(e)) for p in r.paths for e in zip(p, p[1:])}
+    return (f"{reason or 'not completed'}, {len(traversed)} of "
+            f"{len(load_arena(r.arena).edges)} edges")
 
 
 def graph_run(arena: str, k: int, range_m: float, walls: bool, seed: int | None = None):

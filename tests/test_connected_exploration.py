@@ -401,6 +401,33 @@ def test_the_retrace_stops_short_of_a_body_in_its_way():
     assert leash.undo({}, False, lambda vw: (-vw[0], -vw[1])) == (-0.1, -0.5)
 
 
+def test_a_plan_out_along_the_edge_it_is_on_goes_straight_on():
+    """Rule 6's way (ours): under way, a robot whose plan would walk it back to the vertex
+    it left only to leave that vertex again along the same edge (a retreat to the root
+    along the way it is going, say) goes straight on instead; one already told to walk
+    back, or still on the vertex centre, keeps the plan as made."""
+    from algorithms.exploration.relay import RETREAT, Leg
+
+    def robot(under_way: bool, turned: bool) -> ConnectedExplorer:
+        r = ConnectedExplorer(1, make_minds("incidence-dfs", 1, None)[0],
+                              Tether(1, range_m=1.0))
+        # it came from a (left by 0.0 rad) to b (arrived by pi), and left b by pi + 0.05
+        r.route, r.leg = [Leg("a", 0.0, 3.1416)], Leg("b", 3.1416 + 0.05)
+        r.under_way, r.turned = under_way, turned
+        r.mode, r.task = RETREAT, ((), None, 0.0)
+        r._head_for([], None, 0.0)
+        return r
+
+    assert robot(True, False).plan == []  # on to a, the root: the route ends there
+    assert robot(True, False).direction(0.3) == 1
+    assert robot(True, True).plan == [("back",), ("go", 3.1416)]
+    assert robot(False, False).plan == [("back",), ("go", 3.1416)]
+    other = robot(True, False)
+    other.leg = Leg("b", 1.5)  # it left b along another edge: back first
+    other._head_for([], None, 0.0)
+    assert other.plan == [("back",), ("go", 3.1416)]
+
+
 def test_a_robot_setting_off_adopts_nobody():
     t = Tether(1, range_m=1.0)
     assert t.hear(5, [Message(Adopt(), to=1, sender=2)], {2: (0.5, 0.0)}, willing=False) == []

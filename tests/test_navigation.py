@@ -124,7 +124,10 @@ def test_a_robot_turned_back_part_way_arrives_where_it_left_by_the_edge_it_left_
     along the spoke it left by, on a vertex with edges 90 and 120 degrees apart), on its
     lane (0.7 m, and 1.2 m, past the wall's end at the far vertex of a 1.5 m edge) or
     arriving there (a second into its arrival), the robot is back on the centre it left,
-    measures the same edges, and reports the edge it left along as the one it came by."""
+    measures the same edges, and reports the edge it left along as the one it came by.
+    Short of room for a U-turn it never goes farther from the centre than it was when it
+    turned, or than the point of its spoke from which it finds the spoke facing the centre
+    (clear of a robot waiting where the opposite lane's wall ends)."""
     spec = load_arena(arena)
     x, y = spec.vertices[spec.root]
     sim = Simulation(arena_world_spec(spec, [Pose2D(x, y, 0.0)]))
@@ -148,14 +151,22 @@ def test_a_robot_turned_back_part_way_arrives_where_it_left_by_the_edge_it_left_
         driver.step()
         assert nav.state in (NavigatorState.LEAVING, NavigatorState.ON_EDGE,
                              NavigatorState.ARRIVING), nav.events[-1]
+    short_of_room = not nav.room_to_turn and nav.state is not NavigatorState.ARRIVING
+    turned_at_m = math.dist(sim.poses()[0][:2], (x, y))
+    spoke_point_m = (nav.conv.spoke_inner_radius_m + nav.conv.strip_width_m
+                     + nav.cal.line_ahead_m)
+    farthest_m = 0.0
     nav.turn_back()
     for _ in range(MAX_TICKS_PER_LEG):
         if nav.state is NavigatorState.AT_VERTEX:
             break
         assert nav.state is not NavigatorState.LOST, nav.events[-1]
         driver.step()
+        farthest_m = max(farthest_m, math.dist(sim.poses()[0][:2], (x, y)))
     else:
         raise AssertionError(f"not back at the vertex; events {nav.events[-3:]}")
+    if short_of_room:
+        assert farthest_m <= max(turned_at_m, spoke_point_m) + 0.01, (farthest_m, turned_at_m)
     assert math.dist(sim.poses()[0][:2], (x, y)) < ARRIVAL_TOLERANCE_M
     assert angle_error_deg(nav.arrived_angle, first[0]) < ANGLE_TOLERANCE_DEG
     assert len(nav.edge_angles) == len(first)

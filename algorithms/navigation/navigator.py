@@ -280,9 +280,13 @@ class Navigator:
         its lane ends, if it saw none), and the arrival is by the edge it left along.
         Arriving at the vertex ahead (its lane ended): back by odometry to where the lane
         ended, then the same U-turn. Short of that room (leaving, on the lane before its
-        wall, or in its corridor too near the vertex behind): by odometry to the outer end
-        of the spoke it left by, then in along the spoke to the centre and a scan, as on
-        any arrival, by the edge it left along. (A U-turn there would end with its line
+        wall, or in its corridor too near the vertex behind): by odometry to the point of
+        the spoke it left by from which, facing the centre, its line sensor lies a strip's
+        width in from the spoke's inner end, then in along the spoke to the centre and a
+        scan, as on any arrival, by the edge it left along. (Not the spoke's outer end:
+        there its body reaches within 0.12 m of a robot waiting where the opposite lane's
+        wall ends, 0.26 m from the centre, and each stops for the other for good: on
+        ``lattice:3x3``, 3 robots at 1.2 m, connected, 0.1 m/s, seed 1.) (A U-turn there would end with its line
         sensors short of where the opposite lane starts, and its seek find a neighbouring
         edge's lane or nothing: on ``hex:2x2``, 4 robots at 1.5 m, connected, 0.15 m/s,
         seed 2, a robot turning 0.31 m along its edge would end 0.20 m from the centre,
@@ -313,8 +317,9 @@ class Navigator:
             ])
             self._enter(NavigatorState.LEAVING)
             return
-        # to the outer end of the spoke it left by, then in along it as on any arrival
-        out = self.conv.spoke_radius_m + self.cal.line_ahead_m
+        # to the spoke it left by, its line sensor a strip's width in from the inner
+        # end, then in along it as on any arrival
+        out = self.conv.spoke_inner_radius_m + self.conv.strip_width_m + self.cal.line_ahead_m
         px, py = x + out * math.cos(angle), y + out * math.sin(angle)
         toward, inward = math.atan2(py - odo.y, px - odo.x), wrap(angle + math.pi)
         self._plan = deque([
