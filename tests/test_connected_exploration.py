@@ -628,6 +628,12 @@ def test_embodied_biconnected_team_reports_when_its_docked_robot_fails():
     assert "2 still working" in result.ended_because and result.robots_needed == 2
     assert result.sim_time_s < 1000.0 and result.cut_ticks == 0
     assert result.stopped_robots[0]["robot"] == 1 and result.collisions == 0
+    from mjswarm.cli.explore import summary
+
+    d = result.to_dict()
+    d["world"], d["recording"], d["video"] = "embodied", None, None
+    trips = result.relay_trips
+    assert f"connectivity biconnected: {trips} relay trip{'s' * (trips != 1)}; every " in summary(d)
 
 
 @pytest.mark.slow  # test_a_parent_whose_children_the_world_holds_may_step... holds the rule

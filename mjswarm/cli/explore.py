@@ -420,10 +420,12 @@ def _embodied_lines(result: dict) -> list[str]:
               f"fault: {f['fault']} not fired (the run ended at {end:.1f} s)"
               for f in result["faults"]]
     if result["connectivity"] != "none" and result["connected_share"] is not None:
+        trips = result["relay_trips"]
         lines.append(
-            f"connectivity {result['connectivity']}: every robot reached the base in "
-            f"{100 * result['connected_share']:.1f} % of the ticks ({result['cut_ticks']} "
-            f"cut), biconnected in {100 * result['biconnected_share']:.1f} %")
+            f"connectivity {result['connectivity']}: {trips} relay trip{'s' * (trips != 1)}; "
+            f"every robot reached the base in {100 * result['connected_share']:.1f} % of "
+            f"the ticks ({result['cut_ticks']} cut), biconnected in "
+            f"{100 * result['biconnected_share']:.1f} %")
     if result["radio_messages"] is not None:
         agreement = result["radio_belief_agreement"]
         lines.append(
