@@ -632,8 +632,8 @@ def test_embodied_biconnected_team_reports_when_its_docked_robot_fails():
 
     d = result.to_dict()
     d["world"], d["recording"], d["video"] = "embodied", None, None
-    trips = result.relay_trips
-    assert f"connectivity biconnected: {trips} relay trip{'s' * (trips != 1)}; every " in summary(d)
+    trips = f"{result.relay_trips} relay trip{'s' * (result.relay_trips != 1)}"
+    assert f"connectivity biconnected: {trips}; every " in summary(d)
 
 
 @pytest.mark.slow  # test_a_parent_whose_children_the_world_holds_may_step... holds the rule

@@ -283,15 +283,15 @@ class Navigator:
         wall, or in its corridor too near the vertex behind): by odometry to the point of
         the spoke it left by from which, facing the centre, its line sensor lies a strip's
         width in from the spoke's inner end, then in along the spoke to the centre and a
-        scan, as on any arrival, by the edge it left along. (Not the spoke's outer end:
-        there its body reaches within 0.12 m of a robot waiting where the opposite lane's
-        wall ends, 0.26 m from the centre, and each stops for the other for good: on
-        ``lattice:3x3``, 3 robots at 1.2 m, connected, 0.1 m/s, seed 1.) (A U-turn there would end with its line
-        sensors short of where the opposite lane starts, and its seek find a neighbouring
-        edge's lane or nothing: on ``hex:2x2``, 4 robots at 1.5 m, connected, 0.15 m/s,
-        seed 2, a robot turning 0.31 m along its edge would end 0.20 m from the centre,
-        its sensors short of the lane's start at 0.16 m, and be lost.) All ours
-        (Nagavarapu et al.'s robots never turned back)."""
+        scan, as on any arrival, by the edge it left along. (A U-turn there would end with
+        its line sensors short of where the opposite lane starts, and its seek find a
+        neighbouring edge's lane or nothing: on ``hex:2x2``, 4 robots at 1.5 m,
+        connected, 0.15 m/s, seed 2, a robot turning 0.31 m along its edge would end 0.20
+        m from the centre, its sensors short of the lane's start at 0.16 m, and be lost.
+        Nor by the spoke's outer end: there its body reaches within 0.12 m of a robot
+        waiting where the opposite lane's wall ends, 0.26 m from the centre, and each
+        stops for the other for good: on ``lattice:3x3``, 3 robots at 1.2 m, connected,
+        0.1 m/s, seed 1.) All ours (Nagavarapu et al.'s robots never turned back)."""
         if self.state not in (NavigatorState.LEAVING, NavigatorState.ON_EDGE,
                               NavigatorState.ARRIVING):
             raise RuntimeError(f"turn_back() needs the robot on an edge, it is {self.state.value}")
