@@ -57,6 +57,7 @@ def outcome(r) -> str:
     explored and the robots the arena needs; a run that reached its time limit with the
     share of the edges its robots had traversed."""
     from mjswarm.arena import load_arena
+    from mjswarm.experiments.results import traversed_edges
 
     if r.completed:
         return "completed"
@@ -64,8 +65,7 @@ def outcome(r) -> str:
     if "explored " in reason:
         explored = reason.split("explored ")[1].split(";")[0]
         return f"{reason.split(' with ')[0]}, {explored}, needs {r.robots_needed}"
-    traversed = {tuple(sorted(e)) for p in r.paths for e in zip(p, p[1:])}
-    return (f"{reason or 'not completed'}, {len(traversed)} of "
+    return (f"{reason or 'not completed'}, {len(traversed_edges(r.paths))} of "
             f"{len(load_arena(r.arena).edges)} edges")
 
 

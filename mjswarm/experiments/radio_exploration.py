@@ -63,7 +63,7 @@ from mjswarm.errors import MjswarmError
 from mjswarm.experiments.graph_exploration import default_max_time
 from mjswarm.experiments.minds import strategy_name
 from mjswarm.experiments.reach import robots_needed
-from mjswarm.experiments.results import ExplorationResult, Paths
+from mjswarm.experiments.results import ExplorationResult, Paths, traversed_edges
 from mjswarm.worlds.graphworld import GraphWorld
 from mjswarm.worlds.loop import Loop, LoopFunctions
 from mjswarm.worlds.radiograph import ANSWER, TICKS_PER_UNIT, RadioGraphWorld
@@ -81,7 +81,7 @@ def stall_verdict(robots: int, range_m: float, paths: list[list], edges: int,
     ``needed``, :func:`~mjswarm.experiments.reach.robots_needed`: no strategy could
     complete it) or the team's stall, and its text, with the share of the ``edges`` true
     edges its ``paths`` (vertex sequences, one per robot) covered."""
-    explored = {tuple(sorted(e)) for p in paths for e in zip(p, p[1:])}
+    explored = traversed_edges(paths)
     working = robots if working is None else working
     infeasible = working < needed
     text = (f"{'infeasible' if infeasible else 'stalled'} with {robots} robots at range "

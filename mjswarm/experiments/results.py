@@ -41,6 +41,11 @@ class ExplorationResult:
         return d
 
 
+def traversed_edges(paths) -> set[tuple[str, str]]:
+    """The edges (sorted vertex pairs) that paths of vertices (one per robot) traversed."""
+    return {tuple(sorted(e)) for p in paths for e in zip(p, p[1:])}
+
+
 class Paths:
     """Each robot's path of vertices from the root, and the team's declaration of
     completion: what every world accounts the same way, while each world keeps its own
