@@ -107,7 +107,12 @@ def scenarios(body) -> list[Driven]:
     assert nav.state is S.LOST
     nav = drive().at_vertex()
     nav.depart(0.0)
-    nav.turn_back()  # short of its corridor: by odometry to the spoke it left by
+    nav.turn_back()  # still on the centre it left: a scan there
+    assert nav.state is S.SCANNING and nav.leg is Leg.BACK
+    nav = drive().at_vertex()
+    nav.depart(0.0)
+    nav.odometry.x += nav.conv.strip_width_m  # out of the centre, short of its corridor:
+    nav.turn_back()  # by odometry to the spoke it left by
     assert nav.state is S.ARRIVING
     nav = drive().at_vertex()
     nav.depart(0.0)

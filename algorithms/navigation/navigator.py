@@ -142,6 +142,7 @@ NAVIGATOR_TRANSITIONS: dict[NavigatorState, dict[NavigatorState, str]] = {
     NavigatorState.LEAVING: {
         NavigatorState.ON_EDGE: "a sensor finds its own lane",
         NavigatorState.ARRIVING: "turn_back() short of its corridor",
+        NavigatorState.SCANNING: "turn_back() still on the centre it left",
         NavigatorState.LOST: "no lane strip ahead"},
     NavigatorState.ON_EDGE: {
         NavigatorState.ARRIVING: "the lane ends after its wall; turn_back() short of "
@@ -291,13 +292,23 @@ class Navigator:
         Nor by the spoke's outer end: there its body reaches within 0.12 m of a robot
         waiting where the opposite lane's wall ends, 0.26 m from the centre, and each
         stops for the other for good: on ``lattice:3x3``, 3 robots at 1.2 m, connected,
-        0.1 m/s, seed 1.) All ours (Nagavarapu et al.'s robots never turned back)."""
+        0.1 m/s, seed 1.) Still on the centre it left (leaving, its axle within half a
+        strip's width of where it stood: it has only turned): a scan there, as on any
+        arrival, by the edge it left along. (Out to the spoke point and in again would take
+        it towards whatever held it on its way out: on ``tree1``, 5 robots at 2 m,
+        connected, 0.1 m/s, seed 1, a relay that never left its centre drove 9 cm out
+        towards the robot it served, on the lane it had wanted, and stood there for good.)
+        All ours (Nagavarapu et al.'s robots never turned back)."""
         if self.state not in (NavigatorState.LEAVING, NavigatorState.ON_EDGE,
                               NavigatorState.ARRIVING):
             raise RuntimeError(f"turn_back() needs the robot on an edge, it is {self.state.value}")
         x, y, angle = self._left
         self._incoming, self.leg = angle, Leg.BACK
         odo = self.odometry
+        if (self.state is NavigatorState.LEAVING
+                and math.hypot(odo.x - x, odo.y - y) <= self.conv.strip_width_m / 2.0):
+            self._start_scan()
+            return
         if self.room_to_turn or self.state is NavigatorState.ARRIVING:
             plan = []
             if self.state is NavigatorState.ARRIVING:
