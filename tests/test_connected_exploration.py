@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 import json
+import math
 from types import SimpleNamespace
 
 import pytest
@@ -211,6 +212,32 @@ def test_a_relay_counts_its_wait_on_the_way_from_its_acceptance():
         assert robot.mode == TRANSIT
     robot.after(2 * recruit + 1, None, False, {}, held=True)
     assert robot.mode == RELAY
+
+
+@pytest.mark.parametrize("progress, route, plan", [
+    (0.9, "ab", [("go", 0.0), ("go", 1.0), ("to", 2.0, 0.9 - 0.3)]),  # spacing short of it
+    (0.5, "ab", [("go", 0.0), ("to", 1.0, math.inf)]),  # the lane into b, to its end
+    (0.5, "", []),  # the root itself
+])
+def test_a_relay_never_stops_in_the_area_of_the_vertex_its_requester_left(
+        progress, route, plan):
+    """Rule 6 on bodies: a relay stops ``spacing`` short of its requester on the
+    requester's lane, unless that point lies within ``clear`` of the vertex the requester
+    left (inside its area, which it would keep from every other robot); it then stands
+    where the lane into that vertex ends (waiting there for nobody's grant, the world
+    holds it, and it relays), or on the root."""
+    from algorithms.exploration.relay import Leg
+
+    legs = {"a": Leg("a", 0.0, 3.1), "b": Leg("b", 1.0, 4.1)}
+    robot = ConnectedExplorer(0, make_minds("incidence-dfs", 1, None)[0],
+                              Tether(0, range_m=1.0), spacing=0.3, clear=0.25)
+    robot._root = "root"
+    robot.mode = "explore"
+    robot.idle = True
+    wanted = RelayWanted(1, 1, tuple(legs[c] for c in route), Leg("c", 2.0), progress)
+    robot.hear(1, [Message(wanted, sender=1)], {})
+    robot.hear(2, [Message(RelayAccepted(1, 1, 0), sender=1)], {})
+    assert robot.mode == TRANSIT and robot.plan == plan
 
 
 def test_a_relay_whose_children_the_world_holds_goes_back_after_its_patience():

@@ -317,6 +317,37 @@ def test_a_robot_leaving_that_calls_a_relay_gives_the_vertex_up_once_clear_of_it
     assert r.step() is Mode.ON_LANE and r.sent == [LeftVertex()]
 
 
+def test_a_relay_on_its_lane_gives_the_vertex_it_left_up_once_clear_of_its_centre():
+    """A relay (rule 6) standing on its lane CLEAR_BEHIND_M or more out of the vertex it
+    left, short of its corridor, tells the stations it left: it stands out of that area,
+    which others need; nearer, it keeps the vertex."""
+    r = asking(tied=True)
+    assert r.step(EntryGranted(True, ANGLE)) is Mode.LEAVING
+    r.on_lane(corridor=False)
+    r.tie.mode = "relay"
+    r.nav.odometry.distance_m = CLEAR_BEHIND_M - 0.01
+    assert r.step() is Mode.LEAVING and LeftVertex() not in r.sent
+    r.nav.odometry.distance_m = CLEAR_BEHIND_M
+    assert r.step() is Mode.ON_LANE and r.sent == [LeftVertex()]
+
+
+def test_a_leaving_robot_never_backs_off_the_start_of_the_lane_it_found():
+    """The leash's trail is forgotten where the navigator finds its lane: the leaving's
+    sidestep is dead-reckoned and its turns in place are no moves of the trail, so a
+    retrace past the lane's start drives straight back along the lane's line, off every
+    strip."""
+    r = asking(tied=True)
+    assert r.step(EntryGranted(True, ANGLE)) is Mode.LEAVING
+    for _ in range(3):
+        r.step()
+    assert len(r.x.leash._trail) == 4  # leaving (the grant's tick too): moves on the trail
+    r.on_lane(corridor=False)
+    r.step()
+    assert r.x.leash._trail == [(0.1, 0.0)]  # only the move made on its lane
+    r.step()
+    assert len(r.x.leash._trail) == 2
+
+
 def test_a_robot_whose_hidden_parent_leaves_it_no_move_to_undo_stands_pinned():
     """The leash's retrace with its trail spent and the parent still out of its ranging:
     the robot stands as one its leash stopped, and tells its connected exploration it can

@@ -25,15 +25,15 @@ It composes, fed only by its own observation:
   way") when it wants to move and the speed rule or vertex entry stops it. The leash knows
   ranges, not walls: when a wall comes between it and a parent (the link is gone from its
   radio neighbours), it drives its moves since the link was last there backwards (never
-  back into a vertex area it has given up, nor off a vertex centre it reached: moves from
-  before are forgotten; its navigator counts the moves backwards on its odometry, so
-  that its motion resumes from where the body is), and then
-  stands as if the leash had stopped it (so it calls a relay, rule 6) until it has a new
-  parent or sets out on a new leg; it may still walk back along its leg (rule 6), unless a
-  wall cut a link on the way back too (ours). A step of a walk back may use the tether's
-  reserve (rule 3: a U-turn sidesteps across its edge, and a robot at the end of its
-  leash must still be able to turn), and one that turns back in the area of the vertex
-  it arrived at backs out of it at once (that area is its own).
+  back into a vertex area it has given up, nor off a vertex centre it reached or the
+  start of the lane it found: moves from before are forgotten; its navigator counts the
+  moves backwards on its odometry, so that its motion resumes from where the body is),
+  and then stands as if the leash had stopped it (so it calls a relay, rule 6) until it
+  has a new parent or sets out on a new leg; it may still walk back along its leg (rule
+  6), unless a wall cut a link on the way back too (ours). A step of a walk back may use
+  the tether's reserve (rule 3: a U-turn sidesteps across its edge, and a robot at the
+  end of its leash must still be able to turn), and one that turns back in the area of
+  the vertex it arrived at backs out of it at once (that area is its own).
 
 Its modes and the moves between them are in :mod:`algorithms.exploration.modes`.
 
@@ -160,7 +160,11 @@ CLEAR_BEHIND_M = 0.25
 #: on a vertex centre (it would scan off it) and on its way in to one. The arrival's
 #: sidestep, seek and spoke are dead-reckoned moves of a plan the navigator resumes by
 #: odometry; driven backwards and resumed, they end off the centre, where the robot finds
-#: no spoke and is lost. A robot whose parent's link fades there stands, pinned.
+#: no spoke and is lost. A robot whose parent's link fades there stands, pinned. Nor off
+#: the start of its lane: the trail is forgotten where it finds its lane. The leaving's
+#: turns in place are no moves of the trail, so backed out past them it drives straight
+#: back along the lane's line, and resumed off every strip it loses its lane (``lattice:
+#: 3x3``, 3 robots at 1.2 m, connected, seed 1: backed 23 cm, past the centre's line).
 NO_BACKING = frozenset({NavigatorState.ARRIVING, NavigatorState.SCANNING,
                         NavigatorState.AT_VERTEX})
 
@@ -206,7 +210,7 @@ class Explorer(Controller):
         self.control_dt_s = control_dt_s
         #: its connected exploration (rules 1-6) around ``strategy``; None without a tether
         self.connected = None if tether is None else ConnectedExplorer(
-            tether.me, strategy, tether, spacing=RELAY_SPACING_M)
+            tether.me, strategy, tether, spacing=RELAY_SPACING_M, clear=CLEAR_BEHIND_M)
         #: its leash against walls (None without a tether)
         self.leash = None if tether is None else Leash(tether)
         #: passing bodies on its lane (None where it does not pass: tethered, or no radius)
@@ -235,6 +239,7 @@ class Explorer(Controller):
         self._asked: EntryRequest | None = None  # its request, until it departs
         self._asked_at_s = 0.0  # when it sent that request (s)
         self._trips = 0  # relay missions it has set out on (rule 6)
+        self._nav_then = self.nav.state  # its navigator's state in its last tick on the leash
         self._events: list = []  # what it reports this tick (``Command.events``)
         self._said_speed = speed_m_s  # its speed as last reported
         self._held_still_s = 0.0  # how long the speed rule has held it still on its lane
@@ -333,6 +338,9 @@ class Explorer(Controller):
         moving = command.v_m_s != 0.0
         if moving and self._in_the_way(around, command.v_m_s):
             command, moving = Command(messages=command.messages), False
+        if self.nav.state is NavigatorState.ON_EDGE and self._nav_then is not self.nav.state:
+            self.leash.forget()  # on its lane: never backed off the lane's start
+        self._nav_then = self.nav.state
         wanted = self.leash.check(
             (command.v_m_s, command.omega_rad_s) if moving else None,
             (command.v_m_s * self.control_dt_s, 0.0), around, back=self.mode in RETURNING,
@@ -346,10 +354,12 @@ class Explorer(Controller):
         return command._replace(messages=tuple(out))
 
     def _give_up_behind(self, out: list[Message]) -> None:
-        """Leaving a vertex, it calls a relay (rule 6): once ``CLEAR_BEHIND_M`` out, it
-        gives that vertex up (LeftVertex), so that the relay may take its centre; it never
-        backs into it again (its trail is forgotten)."""
-        if (self.mode is Mode.LEAVING and self.connected.calls_relay
+        """Leaving a vertex, it calls a relay (rule 6), or relays from its lane: once
+        ``CLEAR_BEHIND_M`` out, it gives that vertex up (LeftVertex), so that a relay may
+        take its centre and others pass through it; it never backs into it again (its
+        trail is forgotten)."""
+        if (self.mode is Mode.LEAVING
+                and (self.connected.calls_relay or self.connected.mode == RELAY)
                 and self.nav.odometry.distance_m - self._left_at_m >= CLEAR_BEHIND_M):
             self._leave_behind(out)
 

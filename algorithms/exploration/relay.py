@@ -29,9 +29,13 @@ only wait. Rule 6 (ours) brings it a relay, leapfrogging the chain forward:
 * **Transit.** The relay suspends its own task (its strategy is not asked anything and no
   beacon is written until it resumes), goes back to the last vertex where its route and the
   requester's agree, then along the requester's route and leg, and stops where the
-  requester is, less the world's ``spacing`` (or where its own leash stops it). There it
-  stands still: rule 4 lets the requester adopt it, and the requester goes on within
-  range of its relay.
+  requester is, less the world's ``spacing`` (or where its own leash stops it). A point
+  within the world's ``clear`` of the vertex the requester left lies in that vertex's
+  area, which a body standing there keeps from every other robot: the relay then stands
+  where the lane into that vertex ends (vertex entry holds it there, short of the
+  area), or on the root if the requester left the root (ours, for bodies; 0 for
+  points). There it stands still: rule 4 lets the requester adopt it, and the requester
+  goes on within range of its relay.
 * **Release.** A relay holds while it has children. Once it has had none for
   ``RELEASE_UNITS`` (its child went on, or came back and re-attached nearer the base), or
   was never adopted within ``RELAY_PATIENCE_UNITS``, it goes back the same way and resumes
@@ -188,12 +192,16 @@ class ConnectedExplorer:
     the robot's odometry, in the world's measure: the share of the edge in the graph
     world, metres driven since it left the vertex on the MuJoCo robots (a robot compares
     only its own progress with a requester's, on the same leg). A relay stops ``spacing``
-    short of where its requester stood (0 in the graph world; bodies need room).
+    short of where its requester stood, and never within ``clear`` of the vertex the
+    requester left (both 0 in the graph world; bodies need room, and a vertex area holds
+    one body).
     """
 
-    def __init__(self, index: int, mind: Strategy, tether: Tether, spacing: float = 0.0) -> None:
+    def __init__(self, index: int, mind: Strategy, tether: Tether, spacing: float = 0.0,
+                 clear: float = 0.0) -> None:
         self.index = index
         self.spacing = spacing
+        self.clear = clear
         self.mind = mind
         self.tether = tether
         self.flood = Flooder()
@@ -301,7 +309,13 @@ class ConnectedExplorer:
         w = self._wanted
         if self.task is None:  # exploring: suspend the task (else it is suspended already)
             self.task = (tuple(self.route), self.leg, self.progress)
-        self._head_for(w.route, w.leg, max(0.0, w.progress - self.spacing))
+        stop = w.progress - self.spacing
+        if stop >= self.clear:
+            self._head_for(w.route, w.leg, stop)
+        elif w.route:  # short of ``clear``: where the lane into that vertex ends
+            self._head_for(w.route[:-1], w.route[-1], math.inf)
+        else:  # ... or, from the root, on the root
+            self._head_for((), None, 0.0)
         # its waits count from here: held as long before its trip, it is not held on its way
         self.mode, self.stuck, self.held, self.idle, self.stop_at = TRANSIT, 0, 0, False, None
         self.relay_trips += 1
