@@ -328,6 +328,25 @@ def test_a_robot_that_can_take_no_step_keeps_asking_and_never_retreats_or_offers
     assert stuck_for(False)[0].mode == RETREAT
 
 
+def test_a_retreating_robot_that_its_leash_stops_asks_for_a_relay():
+    """Rule 6: a robot walking back to the root (it retreated: nobody came) whose leash
+    stops it asks for a relay as an exploring one does, again and again, stays on its way
+    back, and takes the first offer. Nobody would come to it unasked (``tri:2x3``, 4
+    robots at 2 m, seed 2, 0.15 m/s: R4, pinned in its U-turn by a wall that faded its
+    parent's link, stood there from 240 s until the team's stall at 883 s)."""
+    from algorithms.exploration.relay import RETREAT, Leg
+
+    robot = ConnectedExplorer(1, make_minds("incidence-dfs", 1, None)[0], Tether(1, range_m=1.0))
+    robot.leg, robot.mode = Leg("b0", 0.0), RETREAT
+    asked = []
+    for tick in range(1, 3 * robot._waits.retreat):
+        out = robot.after(tick, (-0.1, 0.0), False, {}, pinned=True)
+        asked += [m.payload for m in out if isinstance(m.payload, RelayWanted)]
+    assert len(asked) >= 2 and asked[0].requester == 1 and robot.mode == RETREAT
+    out = robot.hear(tick + 1, [Message(RelayOffer(1, asked[-1].serial, 0), sender=0)], {})
+    assert RelayAccepted(1, asked[-1].serial, 0) in [m.payload for m in out]
+
+
 def test_a_robot_is_stuck_when_its_leash_stops_it_not_when_it_holds_for_a_child():
     """Rules 2, 4 and 6: a robot whose leash forbade its step counts the tick stuck (it
     calls a relay, then retreats) and its beat says so; one that holds for a child on the

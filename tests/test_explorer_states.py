@@ -29,7 +29,7 @@ from algorithms.exploration.entry import (
     TurnedBack,
     Withdraw,
 )
-from algorithms.exploration.explorer import CLEAR_BEHIND_M, NO_BACKING, Explorer
+from algorithms.exploration.explorer import CLEAR_BEHIND_M, NO_BACKING, U_TURNING, Explorer
 from algorithms.exploration.modes import TERMINAL, TRANSITIONS, Mode
 from algorithms.exploration.leash import Leash
 from algorithms.navigation import NavEvent, NavigatorState
@@ -369,28 +369,34 @@ def test_a_robot_whose_hidden_parent_leaves_it_no_move_to_undo_stands_pinned():
 def test_a_robot_on_its_way_in_to_a_centre_never_backs_out_when_its_parent_fades():
     """On its lane a robot whose parent's link fades drives its last moves backwards; on
     its way in to a vertex centre (the arrival's dead-reckoned sidestep, seek and spoke,
-    NO_BACKING) it stands pinned instead: resumed after a retrace, the arrival would end
-    off the centre."""
+    NO_BACKING) and in a U-turn it stands pinned instead: resumed after a retrace, the
+    arrival would end off the centre, the U-turn off its lanes."""
     assert NavigatorState.ARRIVING in NO_BACKING and NavigatorState.ON_EDGE not in NO_BACKING
 
-    def faded_after_three_ticks_in(state: NavigatorState):
+    def faded_after_three_ticks_in(state: NavigatorState, u_turn: bool = False):
         r = asking(tied=True)
         r.step(EntryGranted(True, ANGLE))
-        r.on_lane()
+        r.on_lane(room=u_turn)
         assert r.step() is Mode.ON_LANE
         r.tie.parents, r.nav.state = (5,), state
         calls = []
         r.tie.after = lambda *args, **kwargs: calls.append(kwargs) or []
         linked = {5: SimpleNamespace(range_m=0.5, bearing_rad=math.pi)}
+        r.tie.sense = -1 if u_turn else 1  # rule 6 sends it back: with room, a U-turn
         for detections in (linked, linked, linked, {}):
             r.t += DT_S
             command = r.x.step(Observation(0, r.t, (math.nan,) * 3, (math.nan,) * 3,
                                            (0.0, 0.0), detections=detections, beacon=None))
+        assert r.x.mode is (U_TURNING if u_turn else Mode.ON_LANE)
         return command, calls[-1]
 
     command, kwargs = faded_after_three_ticks_in(NavigatorState.ON_EDGE)
     assert command.v_m_s < 0.0 and kwargs == {}  # it backs its last move out
     command, kwargs = faded_after_three_ticks_in(NavigatorState.ARRIVING)
+    assert (command.v_m_s, command.omega_rad_s) == (0.0, 0.0) and kwargs == {"pinned": True}
+    # nor in a U-turn on its lane (also dead-reckoned: backed out part-way and resumed,
+    # ``tri:2x3``'s 4 robots at 2 m, seed 2, lost one 25 cm off its lanes)
+    command, kwargs = faded_after_three_ticks_in(NavigatorState.ON_EDGE, u_turn=True)
     assert (command.v_m_s, command.omega_rad_s) == (0.0, 0.0) and kwargs == {"pinned": True}
 
 

@@ -50,7 +50,8 @@ class Leash:
         met on this way, forbids, or None: the move may go, and joins the trail (``move``
         None: the robot stays). ``back``: it walks back along its leg (and, with
         ``reserve``, may use the tether's reserve); ``at_centre``: it stands on a vertex
-        centre, where nothing is backed out of."""
+        centre, or makes another move that is never backed out of (its trail is
+        forgotten)."""
         wanted = None
         if move is not None:
             if self._way(back) in self._occluded or not self.tether.may_step(
