@@ -80,10 +80,14 @@ def test_connected_graph_recording_has_the_tethers(graph_recordings):
 
 
 def _serve_web(recording: Path, port: int) -> subprocess.Popen:
-    """``mjswarm view RECORDING --web --port PORT`` in a process of its own."""
+    """``mjswarm view RECORDING --web --port PORT`` in a process of its own, started as a
+    terminal's foreground command is: with SIGINT at its default action (a runner started
+    in the background by a shell without job control ignores SIGINT, and its children
+    inherit that: Ctrl-C could not reach them)."""
     return subprocess.Popen([sys.executable, "-m", "mjswarm.cli", "view", str(recording),
                              "--web", "--port", str(port)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=REPO, env=_env())
+                            stderr=subprocess.PIPE, text=True, cwd=REPO, env=_env(),
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def _env(**extra) -> dict[str, str]:
