@@ -441,7 +441,7 @@ def test_the_retrace_stops_short_of_a_body_in_its_way():
     assert not in_the_way({1: (-0.30, 0.0), 2: (0.0, 0.18), BASE: (-0.1, 0.0)}, -0.1)
     leash = Leash(Tether(0, range_m=1.0))
     for move in ((0.1, 0.0), (0.1, 0.5)):
-        leash.check(move, (0.002, 0.0), {BASE: (-0.5, 0.0)}, back=False, at_centre=False)
+        leash.check(move, (0.002, 0.0), {BASE: (-0.5, 0.0)}, back=False, no_backing=False)
     blocked = leash.undo({}, False, lambda vw: (-vw[0], -vw[1]), may=lambda vw: False)
     assert blocked is None and len(leash._trail) == 2
     assert leash.undo({}, False, lambda vw: (-vw[0], -vw[1])) == (-0.1, -0.5)

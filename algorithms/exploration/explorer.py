@@ -350,7 +350,7 @@ class Explorer(Controller):
         wanted = self.leash.check(
             (command.v_m_s, command.omega_rad_s) if moving else None,
             (command.v_m_s * self.control_dt_s, 0.0), around, back=self.mode in RETURNING,
-            at_centre=self.nav.state in NO_BACKING or self.mode is U_TURNING)
+            no_backing=self.nav.state in NO_BACKING or self.mode is U_TURNING)
         if wanted is not None:
             command = Command(messages=command.messages)
         out = list(command.messages)

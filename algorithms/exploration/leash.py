@@ -45,13 +45,13 @@ class Leash:
         return not all(q in around for q in self.tether.parents)
 
     def check(self, move: Any, step: Sequence[float], around: Mapping, back: bool,
-              at_centre: bool, reserve: bool = True) -> Sequence[float] | None:
+              no_backing: bool, reserve: bool = True) -> Sequence[float] | None:
         """The ``step`` (m, the robot's displacement) of ``move`` that the leash, or a wall
         met on this way, forbids, or None: the move may go, and joins the trail (``move``
         None: the robot stays). ``back``: it walks back along its leg (and, with
-        ``reserve``, may use the tether's reserve); ``at_centre``: it stands on a vertex
-        centre, or makes another move that is never backed out of (its trail is
-        forgotten)."""
+        ``reserve``, may use the tether's reserve); ``no_backing``: it stands on a vertex
+        centre or makes a move that is never backed out of (an arrival, a U-turn): its
+        trail is forgotten."""
         wanted = None
         if move is not None:
             if self._way(back) in self._occluded or not self.tether.may_step(
@@ -59,7 +59,7 @@ class Leash:
                 wanted = step
             else:
                 self._trail.append(move)
-        if at_centre:
+        if no_backing:
             self._trail = []
         if self.tether.parents != self._parents_then:  # a new parent: try again
             self.new_leg()
