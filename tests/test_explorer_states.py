@@ -400,6 +400,30 @@ def test_a_robot_on_its_way_in_to_a_centre_never_backs_out_when_its_parent_fades
     assert (command.v_m_s, command.omega_rad_s) == (0.0, 0.0) and kwargs == {"pinned": True}
 
 
+def test_a_robot_that_can_go_neither_on_nor_back_says_so_once():
+    """Asking to turn back into the area it is leaving (rule 6 sends it back, no room to
+    turn), a robot whose way on a wall closed tells the stations once: in a swap its own
+    vertex went to another robot, and it would wait for an answer that never comes."""
+    r = asking(tied=True)
+    assert r.step(EntryGranted(True, ANGLE)) is Mode.LEAVING
+    r.on_lane(corridor=False)
+    r.nav.state = NavigatorState.LEAVING
+    r.tie.sense = -1
+    assert r.step() is Mode.TURN_ASKED_LEAVING and r.sent == [TurnedBack(from_lane=False)]
+    r.tie.parents = (5,)  # its parent's link fades
+    r.x.leash.forget()  # no move left to undo: its way on is closed
+    linked = {5: SimpleNamespace(range_m=0.5, bearing_rad=math.pi)}
+    said = []
+    for detections in ({}, {}, linked, linked):
+        r.t += DT_S
+        command = r.x.step(Observation(0, r.t, (math.nan,) * 3, (math.nan,) * 3, (0.0, 0.0),
+                                       detections=detections, beacon=None))
+        said += [m.payload for m in command.messages if m.to == STATION]
+        assert r.x.mode is Mode.TURN_ASKED_LEAVING
+    assert said == [TurnedBack(from_lane=False, way_on_closed=True)]
+    assert r.step(EntryGranted(True)) is Mode.WALKING_BACK and r.nav.turns == 1
+
+
 def test_walking_back_from_the_area_it_leaves():
     r = leaving()
     assert r.step(EntryBlocked(ANGLE)) is Mode.TURN_ASKED_LEAVING

@@ -186,6 +186,12 @@ def test_a_robot_turning_back_short_of_its_corridor_gets_its_vertex_back_at_once
     run.uplink.step()
     assert [m.payload for m in run.uplink.receive_for(0)] == [EntryGranted(clear=True)]
     assert run.stations.entry.target[0] == u and run.stations.entry.leaving[0] is None and run.stations.entry.grants.holder == {u: 0}
+    # its word that its way on is closed, once the vertex is its own: nothing to undo
+    _tell(run, 0, TurnedBack(from_lane=False, way_on_closed=True))
+    run.stations.before_step(run.loop)
+    run.uplink.step()
+    assert run.uplink.receive_for(0) == [] and run.stations.entry.grants.holder == {u: 0}
+    assert run.stations.entry.grants.requests == {} and run.stations.entry.target[0] == u
 
 
 def test_a_robot_turning_back_from_its_lane_waits_for_its_vertex_like_a_centre():
@@ -207,11 +213,8 @@ def test_a_robot_turning_back_from_its_lane_waits_for_its_vertex_like_a_centre()
     assert run.stations.entry.target[0] == u and run.stations.entry.grants.holder == {u: 0}
 
 
-def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws():
-    """In a swap each robot was given the other's vertex: one that then asks to turn back
-    into its old area gets no answer (it goes on), and one that withdraws leaves the
-    other waiting until it has left its area."""
-    run, u, w = _on_fig9()
+def _swapped(run, u, w):
+    """Robots 0 on ``u`` and 1 on ``w`` are granted each other's vertex (a swap)."""
     run.stations.entry.target[:] = [u, w]
     run.stations.entry.grants.occupy(0, u)
     run.stations.entry.grants.occupy(1, w)
@@ -220,7 +223,16 @@ def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws()
     run.stations.before_step(run.loop)
     run.uplink.step()
     for i in (0, 1):
-        run.uplink.receive_for(i)
+        assert [m.payload for m in run.uplink.receive_for(i)] == [
+            EntryGranted(False, _angle(run, *((u, w), (w, u))[i]))]
+
+
+def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws():
+    """In a swap each robot was given the other's vertex: one that then asks to turn back
+    into its old area gets no answer (it goes on), and one that withdraws leaves the
+    other waiting until it has left its area."""
+    run, u, w = _on_fig9()
+    _swapped(run, u, w)
     _tell(run, 0, TurnedBack(from_lane=False))
     run.uplink.step()
     assert run.uplink.receive_for(0) == [] and run.stations.entry.target == [w, u]
@@ -229,6 +241,50 @@ def test_a_swap_partner_keeps_its_grant_when_the_other_turns_back_or_withdraws()
     assert run.stations.entry.grants.holder == {w: 0}
     run.uplink.step()
     assert run.uplink.receive_for(0) == []  # no VertexClear for robot 0
+
+
+def test_a_swap_is_undone_for_a_robot_that_can_go_neither_on_nor_back():
+    """Robot 0 asks to turn back into ``u``, which the swap gave robot 1, and a wall closed
+    its way on: while robot 1 waits on its lane for ``u`` to clear, ``u`` goes back to
+    robot 0 and robot 1's grant becomes a request from its lane, granted once ``u`` is
+    free again (with the angle it had asked for, so robot 1 takes it as its grant)."""
+    run, u, w = _on_fig9()
+    _swapped(run, u, w)
+    entry = run.stations.entry
+    _tell(run, 1, LeftVertex())  # robot 1 is on its lane, out of every area
+    run.uplink.step()
+    assert [m.payload for m in run.uplink.receive_for(0)] == [VertexClear()]
+    _tell(run, 0, TurnedBack(from_lane=False))
+    run.uplink.step()
+    assert run.uplink.receive_for(0) == []  # it may go on: the swap stands
+    _tell(run, 0, TurnedBack(from_lane=False, way_on_closed=True))
+    run.uplink.step()
+    assert [m.payload for m in run.uplink.receive_for(0)] == [EntryGranted(clear=True)]
+    assert run.uplink.receive_for(1) == []  # robot 1 keeps waiting where it is
+    assert entry.grants.holder == {u: 0} and entry.target == [u, None]
+    assert entry.grants.requests[1].at is None and entry.grants.requests[1].to == u
+    run.stations.before_step(run.loop)
+    assert entry.grants.holder == {u: 0}  # robot 0 stands in u: robot 1 waits
+    _tell(run, 0, EntryRequest(_angle(run, u, w)))  # robot 0 leaves u for w at last
+    run.stations.before_step(run.loop)
+    run.uplink.step()
+    assert [m.payload for m in run.uplink.receive_for(0)] == [EntryGranted(True, _angle(run, u, w))]
+    _tell(run, 0, LeftVertex())
+    run.stations.before_step(run.loop)
+    run.uplink.step()
+    assert [m.payload for m in run.uplink.receive_for(1)] == [EntryGranted(True, _angle(run, w, u))]
+    assert entry.grants.holder == {u: 1, w: 0}
+
+
+def test_a_swap_stands_while_its_partner_is_still_in_the_area_it_left():
+    """Robot 1 has not yet left ``w``'s area: undoing the swap would leave it two vertex
+    areas to wait between, so robot 0's word that its way on is closed changes nothing."""
+    run, u, w = _on_fig9()
+    _swapped(run, u, w)
+    _tell(run, 0, TurnedBack(from_lane=False, way_on_closed=True))
+    run.uplink.step()
+    assert run.uplink.receive_for(0) == [] and run.stations.entry.target == [w, u]
+    assert run.stations.entry.grants.holder == {u: 1, w: 0}
 
 
 def test_a_withdrawn_clear_grant_is_taken_back():

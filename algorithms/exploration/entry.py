@@ -32,10 +32,14 @@ and every message is counted with the radio's. The protocol, from the robot's si
    the vertex behind (``from_lane`` False: short of its corridor, or too near for a
    U-turn clear of that area) it asks to return there and turns once it has the grant:
    at once if it never left that area, and no answer if the station gave it to another
-   robot meanwhile (a swap: it goes on, and turns farther along); else when the vertex is
-   free. Turned on its lane (``from_lane`` True, sent once it follows its new lane, out of
-   the area ahead), it waits for the vertex behind where its new lane's wall ends; both
-   wait as a request from a centre does. A robot granted a clear vertex while it
+   robot meanwhile (a swap: it goes on, and turns farther along; a robot whose way on a
+   wall closed says so in a second :class:`TurnedBack`, ``way_on_closed``, and if the
+   other robot still waits on its lane for the vertex to clear, the swap is undone: its
+   grant becomes a request from its lane again, and the vertex goes back to the robot
+   that stands in its area, which could otherwise neither go on nor back); else when
+   the vertex is free. Turned on its lane (``from_lane`` True, sent once it follows its
+   new lane, out of the area ahead), it waits for the vertex behind where its new lane's
+   wall ends; both wait as a request from a centre does. A robot granted a clear vertex while it
    must hold (rule 2 of the tether: it was adopted while it waited) sends :class:`Withdraw`:
    the station takes the grant back, and the robot asks again once it may move (rule 2), so
    that it does not keep two vertex areas while it stands in one (a robot granted a
@@ -184,9 +188,12 @@ class Withdraw(NamedTuple):
 
 class TurnedBack(NamedTuple):
     """Robot → station: I walk back along my edge; free the vertex ahead, give me the one
-    I left (``from_lane``: I turned on my lane; else I am still in its area)."""
+    I left (``from_lane``: I turned on my lane; else I am still in its area).
+    ``way_on_closed``: sent after one without it, nor can I go on (a wall cut my
+    parent's link on this way): step 5's swap is undone."""
 
     from_lane: bool
+    way_on_closed: bool = False
 
 
 class EntryGranted(NamedTuple):
@@ -425,7 +432,7 @@ class EntryStations:
         if isinstance(payload, EntryRequest):
             self._request(i, payload, now_s)
         elif isinstance(payload, TurnedBack):
-            self._turned_back(i, payload.from_lane, now_s)
+            self._turned_back(i, payload.from_lane, payload.way_on_closed, now_s)
         elif isinstance(payload, Withdraw):
             self._withdraw(i)
         elif isinstance(payload, GiveUp):
@@ -486,15 +493,20 @@ class EntryStations:
             self.leaving[i] = None
         self._tell_clear()
 
-    def _turned_back(self, i: int, from_lane: bool, now_s: float) -> None:
+    def _turned_back(self, i: int, from_lane: bool, way_on_closed: bool,
+                     now_s: float) -> None:
         """Robot ``i`` walks back along its edge (step 5): short of its corridor it gets
         the vertex behind back at once, unless the station gave it to another robot (a
         swap: no answer, and it goes on; if that robot has stopped for good since, the
-        vertex is free and its own again); else it asks for it as from a centre, and the
-        grant tells it when it may turn, or enter."""
+        vertex is free and its own again; if ``i`` cannot go on either, the swap is undone
+        while that robot still waits on its lane, :meth:`_undo_swap`); else it asks for it
+        as from a centre, and the grant tells it when it may turn, or enter."""
         back = self.came_from[i]
         holder = self.grants.holder.get(back)
-        if not from_lane and self.leaving[i] == back and holder not in (None, i):
+        swapped = not from_lane and self.leaving[i] == back and holder not in (None, i)
+        if way_on_closed and not swapped:
+            return  # it says so after its TurnedBack: only a swap has anything to undo
+        if swapped and not (way_on_closed and self._undo_swap(holder, back, now_s)):
             return
         self.awaiting_clear.discard(i)
         self.grants.release(i, self.target[i])
@@ -506,6 +518,20 @@ class EntryStations:
             self.target[i], self.asked[i] = None, None  # the grant answers no EntryRequest
             self.grants.request(i, None, back, now_s)
         self._tell_clear()
+
+    def _undo_swap(self, j: int, vertex: str, now_s: float) -> bool:
+        """Take ``vertex`` back from robot ``j``, granted it in a swap, if ``j`` waits for it
+        on its lane (clear of the vertex it left, told ``vertex`` is not clear yet): its
+        grant becomes a request from its lane again, answered as any (it keeps waiting
+        where its lane's wall ends meanwhile). False (nothing changed) if ``j`` is not
+        waiting so."""
+        if j not in self.awaiting_clear or self.leaving[j] is not None:
+            return False
+        self.awaiting_clear.discard(j)
+        self.grants.release(j, vertex)
+        self.target[j] = None
+        self.grants.request(j, None, vertex, now_s)
+        return True
 
     def release(self, i: int, now_s: float) -> None:
         """Robot ``i`` stopped for good (or was switched off): its holds go; a station

@@ -250,6 +250,7 @@ class Explorer(Controller):
         self._said_speed = speed_m_s  # its speed as last reported
         self._held_still_s = 0.0  # how long the speed rule has held it still on its lane
         self._wait_from_m: float | None = None  # odometry distance where it began to wait
+        self._said_way_on_closed = False  # asking to turn, it told the stations so
 
     @property
     def finished(self) -> bool:
@@ -357,6 +358,7 @@ class Explorer(Controller):
         out += self.connected.after(now, wanted, command.v_m_s != 0.0, around, self._held,
                                     self.leash.cut_on_this_way(self.mode in RETURNING))
         self._give_up_behind(out)
+        self._say_way_on_closed(out)
         return command._replace(messages=tuple(out))
 
     def _give_up_behind(self, out: list[Message]) -> None:
@@ -368,6 +370,17 @@ class Explorer(Controller):
                 and (self.connected.calls_relay or self.connected.mode == RELAY)
                 and self.nav.odometry.distance_m - self._left_at_m >= CLEAR_BEHIND_M):
             self._leave_behind(out)
+
+    def _say_way_on_closed(self, out: list[Message]) -> None:
+        """Asking to turn back into the area it is leaving, with its way on closed by a
+        wall (its leash): it tells the stations once (:class:`~algorithms.exploration.
+        entry.TurnedBack` ``way_on_closed``). In a swap it would otherwise wait for an
+        answer that never comes while it cannot go on, and the robot given its vertex
+        would wait for it to leave: the stations undo the swap (entry step 5)."""
+        if (self.mode is Mode.TURN_ASKED_LEAVING and not self._said_way_on_closed
+                and self.leash.cut_on_this_way(back=False)):
+            self._said_way_on_closed = True
+            out.append(Message(TurnedBack(from_lane=False, way_on_closed=True), STATION))
 
     def _set_out(self, observation: Observation, out: list[Message]) -> None:
         """Rule 6: it accepted a relay mission. On an edge its plan starts with the walk
@@ -404,6 +417,7 @@ class Explorer(Controller):
             out += self.connected.after(now, step, False, around, False,
                                         self.leash.cut_on_this_way(back), pinned=True)
             self._give_up_behind(out)
+            self._say_way_on_closed(out)
             return Command(messages=tuple(out))
         if move is None:
             return self._stand(now, out, around)
@@ -572,6 +586,7 @@ class Explorer(Controller):
         elif self.mode in (Mode.LEAVING, Mode.ON_LANE):
             self._enter(Mode.TURN_ASKED_LEAVING if self.mode is Mode.LEAVING
                         else Mode.TURN_ASKED)
+            self._said_way_on_closed = False
             out.append(Message(TurnedBack(from_lane=False), STATION))
 
     def _turn_back(self, granted: bool) -> None:
