@@ -39,13 +39,13 @@ and every message is counted with the radio's. The protocol, from the robot's si
    that stands in its area, which could otherwise neither go on nor back); else when
    the vertex is free. Turned on its lane (``from_lane`` True, sent once it follows its
    new lane, out of the area ahead), it waits for the vertex behind where its new lane's
-   wall ends; both wait as a request from a centre does. A robot granted a clear vertex while it
-   must hold (rule 2 of the tether: it was adopted while it waited) sends :class:`Withdraw`:
-   the station takes the grant back, and the robot asks again once it may move (rule 2), so
-   that it does not keep two vertex areas while it stands in one (a robot granted a
-   vertex not yet clear keeps it: a swap needs it to leave as soon as it may). A robot
-   that sets out as a relay from a centre where it waits for a grant withdraws too, then
-   asks for the way its mission takes. A grant names the request's angle, so that one
+   wall ends; both wait as a request from a centre does. A robot granted a clear vertex
+   while it must hold (rule 2 of the tether: it was adopted while it waited) sends
+   :class:`Withdraw`: the station takes the grant back, and the robot asks again once it
+   may move (rule 2), so that it does not keep two vertex areas while it stands in one
+   (a robot granted a vertex not yet clear keeps it: a swap needs it to leave as soon as
+   it may). A robot that sets out as a relay from a centre where it waits for a grant
+   withdraws too, then asks for the way its mission takes. A grant names the request's angle, so that one
    overtaken by a withdrawal is known as such. A withdrawn swap leaves the other robot
    waiting, as before, until this one has left the vertex area it was given.
 6. Passing a body that stands on a lane for good has its own protocol
